@@ -1,0 +1,77 @@
+#pragma once
+/// The cluster hierarchy: a binary tree of axis-aligned boxes over the scene's
+/// segments, shared by the visibility module and the hierarchical solver.
+///
+/// Built top-down in O(N log N): each node splits its segments at the median
+/// centroid along the longer axis of the centroids' box (std::nth_element,
+/// linear per level, log N levels). The median keeps the tree balanced
+/// (depth <= ceil(log2(N / leaf_size)) + 1) whatever the distribution, so
+/// no query degrades to a linear scan; boxes of siblings may overlap, which
+/// costs a little culling power but never correctness.
+#include <cstdint>
+#include <vector>
+
+#include "engine/geometry.h"
+
+namespace flatrad {
+
+struct ClusterNode {
+    Box box;                 ///< tight box of the node's segments
+    int32_t child[2] = {-1, -1};  ///< children (both -1 for a leaf)
+    int32_t parent = -1;
+    int32_t first = 0;       ///< the node's segments are order[first .. first+count)
+    int32_t count = 0;
+    int32_t depth = 0;
+    bool leaf() const { return child[0] < 0; }
+};
+
+class Hierarchy {
+public:
+    Hierarchy() = default;
+    /// Builds over `segments` (indices are the caller's segment numbers).
+    /// Leaves hold at most `leaf_size` segments (>= 1).
+    explicit Hierarchy(const std::vector<Segment>& segments, int leaf_size = 2);
+
+    const std::vector<ClusterNode>& nodes() const { return m_nodes; }
+    const ClusterNode& node(int k) const { return m_nodes[static_cast<size_t>(k)]; }
+    int root() const { return m_nodes.empty() ? -1 : 0; }
+    /// Segment numbers, grouped so that each node's are contiguous.
+    const std::vector<int32_t>& order() const { return m_order; }
+    const std::vector<Segment>& segments() const { return m_segments; }
+    int depth() const { return m_depth; }
+
+    /// Visits every segment whose node boxes pass `box_test(const Box&)`,
+    /// calling `on_segment(int segment_number, const Segment&)`. Returns the
+    /// number of nodes visited (for stats).
+    template <class BoxTest, class OnSegment>
+    long query(BoxTest&& box_test, OnSegment&& on_segment, std::vector<int32_t>& stack) const {
+        long visited = 0;
+        if (m_nodes.empty()) return 0;
+        stack.clear();
+        stack.push_back(0);
+        while (!stack.empty()) {
+            const ClusterNode& n = m_nodes[static_cast<size_t>(stack.back())];
+            stack.pop_back();
+            ++visited;
+            if (!box_test(n.box)) continue;
+            if (n.leaf()) {
+                for (int32_t k = n.first; k < n.first + n.count; ++k) {
+                    const int32_t s = m_order[static_cast<size_t>(k)];
+                    on_segment(s, m_segments[static_cast<size_t>(s)]);
+                }
+            } else {
+                stack.push_back(n.child[1]);
+                stack.push_back(n.child[0]);
+            }
+        }
+        return visited;
+    }
+
+private:
+    std::vector<ClusterNode> m_nodes;
+    std::vector<int32_t> m_order;
+    std::vector<Segment> m_segments;
+    int m_depth = 0;
+};
+
+}  // namespace flatrad

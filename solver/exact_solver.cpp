@@ -1,0 +1,248 @@
+#include "solver/exact_solver.h"
+
+#include <omp.h>
+
+#include <Eigen/Dense>
+#include <chrono>
+#include <fmt/format.h>
+
+#include "engine/error.h"
+#include "engine/hierarchy.h"
+#include "engine/compensated_sum.h"
+#include "visibility/exact_visibility.h"
+
+namespace flatrad {
+
+namespace {
+
+// A reflectance-1 element whose form factors into other reflectance-1
+// elements sum to more than 1 - this keeps all its light in that set. The
+// form factors are exact to ~1e-13 (closure tests), so 1e-9 only catches
+// enclosures that are closed up to rounding, while any real opening or
+// absorber (even one 1e-6 of the view) counts as a leak.
+constexpr double closure_tolerance = 1e-9;
+
+struct Element {
+    Segment seg;   // oriented lit-left
+    int patch;
+    int segment;   // scene segment number (blocker to skip)
+    double t0, t1; // file-order parameters along the patch
+    double length;
+};
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+// Finds a set of elements that keeps all light among itself with
+// reflectance 1 in channel c: then I - rho F is singular (DESIGN.md §3).
+// Repeatedly drops elements that leak out of the candidate set.
+std::vector<int> closed_white_set(const Eigen::MatrixXd& F, const std::vector<double>& rho) {
+    const int n = static_cast<int>(rho.size());
+    std::vector<char> in(static_cast<size_t>(n));
+    for (int a = 0; a < n; ++a) in[static_cast<size_t>(a)] = rho[static_cast<size_t>(a)] == 1.0;
+    bool changed = true;
+    while (changed) {
+        changed = false;
+        for (int a = 0; a < n; ++a) {
+            if (!in[static_cast<size_t>(a)]) continue;
+            CompensatedSum kept;
+            for (int b = 0; b < n; ++b)
+                if (in[static_cast<size_t>(b)]) kept.add(F(a, b));
+            if (kept.value() < 1 - closure_tolerance) {
+                in[static_cast<size_t>(a)] = 0;
+                changed = true;
+            }
+        }
+    }
+    std::vector<int> set;
+    for (int a = 0; a < n; ++a)
+        if (in[static_cast<size_t>(a)]) set.push_back(a);
+    return set;
+}
+
+}  // namespace
+
+Solution solve_exact(const Scene& scene, const ExactSolverOptions& options) {
+    const auto t_start = Clock::now();
+    const int K = options.subdivide;
+    if (K < 1) throw InputError(scene.file, "--subdivide", fmt::format("expected an integer >= 1, found {}", K));
+    const int threads = options.threads > 0 ? options.threads : omp_get_max_threads();
+    const int C = scene.channels;
+
+    // 1. Elements: K equal pieces of each patch, along its lit-left orientation.
+    std::vector<Element> elems;
+    elems.reserve(scene.patches.size() * static_cast<size_t>(K));
+    for (size_t p = 0; p < scene.patches.size(); ++p) {
+        const Patch& patch = scene.patches[p];
+        const Segment o = scene.patch_segment(static_cast<int>(p));
+        for (int k = 0; k < K; ++k) {
+            const double s0 = static_cast<double>(k) / K, s1 = static_cast<double>(k + 1) / K;
+            Element e;
+            e.seg = {k == 0 ? o.a : lerp(o.a, o.b, s0), k + 1 == K ? o.b : lerp(o.a, o.b, s1)};
+            e.patch = static_cast<int>(p);
+            e.segment = patch.segment;
+            // The oriented segment runs against the file order for a right-lit patch.
+            e.t0 = patch.lit_left ? s0 : 1 - s1;
+            e.t1 = patch.lit_left ? s1 : 1 - s0;
+            e.length = patch.length / K;
+            elems.push_back(e);
+        }
+    }
+    const int n = static_cast<int>(elems.size());
+
+    // Unlit sides absorb everything they receive (SPEC): they are sinks.
+    std::vector<std::pair<Segment, int>> sinks;
+    for (size_t s = 0; s < scene.segments.size(); ++s) {
+        const SceneSegment& ss = scene.segments[s];
+        if (!ss.lit_left) sinks.push_back({ss.seg, static_cast<int>(s)});
+        if (!ss.lit_right) sinks.push_back({ss.seg.reversed(), static_cast<int>(s)});
+    }
+
+    // 2. Form factors, both cores: F(a, b) for every element pair, and the
+    //    fraction of each element's light that lands on unlit sides.
+    const auto t_ff = Clock::now();
+    const Hierarchy hierarchy(scene.segment_geometry());
+    const ExactVisibility visibility(hierarchy);
+    Eigen::MatrixXd F = Eigen::MatrixXd::Zero(n, n);
+    std::vector<double> to_sinks(static_cast<size_t>(n), 0.0);
+    VisibilityStats vis;
+    long links = 0;
+#pragma omp parallel num_threads(threads) reduction(+ : links)
+    {
+        ExactWorkspace ws;
+        VisibilityStats local;
+#pragma omp for schedule(dynamic, 1)
+        for (int a = 0; a < n; ++a) {
+            const Element& ea = elems[static_cast<size_t>(a)];
+            for (int b = a + 1; b < n; ++b) {
+                const Element& eb = elems[static_cast<size_t>(b)];
+                if (ea.segment == eb.segment) continue;  // collinear: no exchange
+                const double X = visibility.exchange(ea.seg, eb.seg, ea.segment, eb.segment, ws, local);
+                if (X == 0) continue;
+                F(a, b) = X / ea.length;  // reciprocity: L_a F_ab = L_b F_ba = X
+                F(b, a) = X / eb.length;
+                links += 2;
+            }
+            CompensatedSum sunk;
+            for (const auto& [seg, s] : sinks) {
+                if (s == ea.segment) continue;
+                sunk.add(visibility.exchange(ea.seg, seg, ea.segment, s, ws, local));
+            }
+            to_sinks[static_cast<size_t>(a)] = sunk.value() / ea.length;
+        }
+#pragma omp critical
+        vis += local;
+    }
+    const double ff_time = seconds_since(t_ff);
+
+    // 3. Refuse a system without a unique solution, then solve each channel
+    //    directly: (I - rho F) B = E.
+    const auto t_solve = Clock::now();
+    Eigen::MatrixXd B(n, C);
+    double residual = 0;
+    std::vector<double> rho_prev;
+    Eigen::PartialPivLU<Eigen::MatrixXd> lu;
+    for (int c = 0; c < C; ++c) {
+        std::vector<double> rho(static_cast<size_t>(n));
+        Eigen::VectorXd E(n);
+        for (int a = 0; a < n; ++a) {
+            const Material& m = scene.materials[static_cast<size_t>(scene.patches[static_cast<size_t>(elems[static_cast<size_t>(a)].patch)].material)];
+            rho[static_cast<size_t>(a)] = m.reflectance[static_cast<size_t>(c)];
+            E(a) = m.emission[static_cast<size_t>(c)];
+        }
+        const std::vector<int> closed = closed_white_set(F, rho);
+        if (!closed.empty()) {
+            std::string names;
+            int listed = -1;
+            for (int a : closed) {
+                const int surf = scene.patches[static_cast<size_t>(elems[static_cast<size_t>(a)].patch)].surface;
+                if (surf == listed || names.find("'" + scene.surfaces[static_cast<size_t>(surf)].name + "'") != std::string::npos)
+                    continue;
+                listed = surf;
+                names += (names.empty() ? "'" : ", '") + scene.surfaces[static_cast<size_t>(surf)].name + "'";
+            }
+            throw InputError(scene.file, "",
+                             fmt::format("no unique solution: {} enclose(s) light with reflectance 1{} and "
+                                         "nothing absorbs it; lower a reflectance below 1",
+                                         names, C > 1 ? fmt::format(" in channel {}", c) : std::string{}));
+        }
+        Eigen::MatrixXd A = -F;
+        for (int a = 0; a < n; ++a) {
+            A.row(a) *= rho[static_cast<size_t>(a)];
+            A(a, a) += 1;
+        }
+        if (rho != rho_prev) {
+            lu.compute(A);
+            rho_prev = rho;
+        }
+        B.col(c) = lu.solve(E);
+        const double scale = std::max(E.cwiseAbs().maxCoeff(), B.col(c).cwiseAbs().maxCoeff());
+        if (scale > 0) residual = std::max(residual, (A * B.col(c) - E).cwiseAbs().maxCoeff() / scale);
+    }
+    const double solve_time = seconds_since(t_solve);
+
+    // 4. Results per patch (SPEC order) and totals.
+    Solution sol;
+    sol.method = "exact";
+    sol.subdivide = K;
+    sol.channels = C;
+    sol.patches.resize(scene.patches.size());
+    for (int a = 0; a < n; ++a) {
+        const Element& e = elems[static_cast<size_t>(a)];
+        ElementValue v;
+        v.t0 = e.t0;
+        v.t1 = e.t1;
+        v.B.resize(static_cast<size_t>(C));
+        for (int c = 0; c < C; ++c) v.B[static_cast<size_t>(c)] = B(a, c);
+        sol.patches[static_cast<size_t>(e.patch)].elements.push_back(std::move(v));
+    }
+    for (PatchResult& pr : sol.patches) {
+        std::sort(pr.elements.begin(), pr.elements.end(),
+                  [](const ElementValue& x, const ElementValue& y) { return x.t0 < y.t0; });
+        pr.radiosity.assign(static_cast<size_t>(C), 0.0);
+        for (int c = 0; c < C; ++c) {
+            CompensatedSum s;
+            for (const ElementValue& v : pr.elements) s.add(v.B[static_cast<size_t>(c)]);
+            pr.radiosity[static_cast<size_t>(c)] = s.value() / static_cast<double>(pr.elements.size());
+        }
+    }
+    const Eigen::MatrixXd H = F * B;  // irradiance on each element
+    for (int c = 0; c < C; ++c) {
+        CompensatedSum emitted, absorbed, escaped;
+        for (int a = 0; a < n; ++a) {
+            const Element& e = elems[static_cast<size_t>(a)];
+            const Material& m = scene.materials[static_cast<size_t>(scene.patches[static_cast<size_t>(e.patch)].material)];
+            const double rho = m.reflectance[static_cast<size_t>(c)];
+            emitted.add(e.length * m.emission[static_cast<size_t>(c)]);
+            absorbed.add(e.length * (1 - rho) * H(a, c));
+            absorbed.add(e.length * B(a, c) * to_sinks[static_cast<size_t>(a)]);
+            CompensatedSum row;
+            row.add(1);
+            for (int b = 0; b < n; ++b) row.add(-F(a, b));
+            row.add(-to_sinks[static_cast<size_t>(a)]);
+            escaped.add(e.length * B(a, c) * row.value());
+        }
+        const double em = emitted.value(), ab = absorbed.value();
+        // Escaped power in a closed scene is 1 - (a sum that is 1 up to
+        // rounding): report rounding-level values as 0, not as tiny negatives.
+        double es = escaped.value();
+        if (std::abs(es) <= 1e-12 * std::max(em, ab)) es = 0;
+        sol.totals.emitted.push_back(em);
+        sol.totals.absorbed.push_back(ab);
+        sol.totals.escaped.push_back(es);
+        sol.totals.balance.push_back(em > 0 ? std::abs(em - ab - es) / em : 0.0);
+    }
+
+    sol.stats.form_factor_time_s = ff_time;
+    sol.stats.linear_solve_time_s = solve_time;
+    sol.stats.elements = n;
+    sol.stats.links = links;
+    sol.stats.iterations = 0;
+    sol.stats.residual = residual;
+    sol.stats.threads = threads;
+    sol.stats.visibility = vis;
+    sol.stats.time_s = seconds_since(t_start);
+    return sol;
+}
+
+}  // namespace flatrad

@@ -1,0 +1,72 @@
+#include "solver/group_form_factor.h"
+
+#include <omp.h>
+
+#include <chrono>
+
+#include "engine/compensated_sum.h"
+#include "engine/formfactor.h"
+#include "engine/hierarchy.h"
+#include "visibility/exact_visibility.h"
+
+namespace flatrad {
+
+GroupFormFactor group_form_factor(const Scene& scene, const std::vector<int>& from, const std::vector<int>& to,
+                                  FormFactorMethod method) {
+    const auto t0 = std::chrono::steady_clock::now();
+    auto patches_of = [&](const std::vector<int>& surfaces) {
+        std::vector<int> out;
+        for (size_t p = 0; p < scene.patches.size(); ++p)
+            for (int s : surfaces)
+                if (scene.patches[p].surface == s) {
+                    out.push_back(static_cast<int>(p));
+                    break;
+                }
+        return out;
+    };
+    const std::vector<int> A = patches_of(from), B = patches_of(to);
+    CompensatedSum L_A, L_B;
+    for (int p : A) L_A.add(scene.patches[static_cast<size_t>(p)].length);
+    for (int p : B) L_B.add(scene.patches[static_cast<size_t>(p)].length);
+
+    const Hierarchy hierarchy(scene.segment_geometry());
+    const ExactVisibility visibility(hierarchy);
+    // X_ij = L_i F_ij is symmetric, so one sum gives both directions:
+    // F_AB = sum X / L_A, F_BA = sum X / L_B.
+    std::vector<double> row(A.size(), 0.0);
+    VisibilityStats stats;
+#pragma omp parallel
+    {
+        ExactWorkspace ws;
+        VisibilityStats local;
+#pragma omp for schedule(dynamic, 1)
+        for (size_t a = 0; a < A.size(); ++a) {
+            const Patch& pa = scene.patches[static_cast<size_t>(A[a])];
+            const Segment sa = scene.patch_segment(A[a]);
+            CompensatedSum sum;
+            for (int q : B) {
+                const Patch& pb = scene.patches[static_cast<size_t>(q)];
+                if (pa.segment == pb.segment) continue;  // one line: no exchange
+                const Segment sb = scene.patch_segment(q);
+                if (method == FormFactorMethod::Unoccluded) {
+                    sum.add(form_factor_unoccluded(sa, sb) * pa.length);
+                } else {
+                    sum.add(visibility.exchange(sa, sb, pa.segment, pb.segment, ws, local));
+                }
+            }
+            row[a] = sum.value();
+        }
+#pragma omp critical
+        stats += local;
+    }
+    CompensatedSum X;
+    for (double r : row) X.add(r);
+    GroupFormFactor out;
+    out.F = L_A.value() > 0 ? X.value() / L_A.value() : 0.0;
+    out.F_reverse = L_B.value() > 0 ? X.value() / L_B.value() : 0.0;
+    out.stats = stats;
+    out.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return out;
+}
+
+}  // namespace flatrad

@@ -1,0 +1,48 @@
+#pragma once
+/// What a solve returns: per-patch radiosity (SPEC numbering), per-element
+/// values, energy totals and what the run did. apps/ writes it as the result
+/// file of SPEC.md.
+#include <string>
+#include <vector>
+
+#include "visibility/stats.h"
+
+namespace flatrad {
+
+struct ElementValue {
+    double t0 = 0, t1 = 1;     ///< parameter along the patch, file order a (0) -> b (1)
+    std::vector<double> B;     ///< radiosity per channel
+};
+
+struct PatchResult {
+    std::vector<double> radiosity;      ///< length-weighted mean per channel
+    std::vector<ElementValue> elements; ///< sorted by t0
+};
+
+struct Totals {
+    std::vector<double> emitted, absorbed, escaped, balance;  ///< per channel (SPEC)
+};
+
+struct SolveStats {
+    double time_s = 0;
+    double form_factor_time_s = 0;
+    double linear_solve_time_s = 0;
+    long elements = 0;
+    long links = 0;          ///< non-zero element-pair form factors
+    long iterations = 0;     ///< 0 for a direct solve
+    double residual = 0;     ///< max over channels of ||(I - rho F) B - E||_inf / ||E||_inf
+    int threads = 1;
+    VisibilityStats visibility;
+};
+
+struct Solution {
+    std::string method;      ///< "exact" or "hierarchical"
+    int subdivide = 1;
+    double eps = 0, vis_eps = 0;
+    int channels = 1;
+    std::vector<PatchResult> patches;  ///< SPEC patch order
+    Totals totals;
+    SolveStats stats;
+};
+
+}  // namespace flatrad

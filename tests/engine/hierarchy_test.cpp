@@ -1,0 +1,101 @@
+// The cluster hierarchy (engine/hierarchy.h): structure and queries against
+// a linear scan.
+#include "engine/hierarchy.h"
+
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <random>
+#include <set>
+
+using namespace flatrad;
+
+namespace {
+std::vector<Segment> random_segments(std::mt19937_64& rng, int n) {
+    std::uniform_real_distribution<double> U(0, 1);
+    std::vector<Segment> s;
+    for (int k = 0; k < n; ++k) {
+        const Vec2 c{U(rng), U(rng)};
+        const Vec2 d{0.02 * (U(rng) - 0.5), 0.02 * (U(rng) - 0.5)};
+        s.push_back({c - d, c + d});
+    }
+    return s;
+}
+bool overlap(const Box& a, const Box& b) {
+    return !(a.hi.x < b.lo.x || a.lo.x > b.hi.x || a.hi.y < b.lo.y || a.lo.y > b.hi.y);
+}
+}  // namespace
+
+TEST_CASE("hierarchy: every segment in one leaf, boxes nest, depth is logarithmic") {
+    std::mt19937_64 rng(5);
+    for (int n : {1, 2, 3, 17, 1000, 4096}) {
+        const auto segs = random_segments(rng, n);
+        for (int leaf : {1, 2, 4}) {
+            const Hierarchy h(segs, leaf);
+            std::vector<int> seen(static_cast<size_t>(n), 0);
+            for (const ClusterNode& nd : h.nodes()) {
+                if (nd.leaf()) {
+                    CHECK(nd.count <= std::max(leaf, 1));
+                    for (int k = nd.first; k < nd.first + nd.count; ++k) {
+                        const int s = h.order()[static_cast<size_t>(k)];
+                        ++seen[static_cast<size_t>(s)];
+                        const Segment& g = segs[static_cast<size_t>(s)];
+                        CHECK(nd.box.lo.x <= std::min(g.a.x, g.b.x));
+                        CHECK(nd.box.hi.y >= std::max(g.a.y, g.b.y));
+                    }
+                } else {
+                    for (int c : nd.child) {
+                        const Box& cb = h.node(c).box;
+                        CHECK(nd.box.lo.x <= cb.lo.x);
+                        CHECK(nd.box.lo.y <= cb.lo.y);
+                        CHECK(nd.box.hi.x >= cb.hi.x);
+                        CHECK(nd.box.hi.y >= cb.hi.y);
+                        CHECK(h.node(c).parent >= 0);
+                    }
+                }
+            }
+            for (int c : seen) CHECK(c == 1);
+            // Median splits: depth <= ceil(log2(n / leaf)) + 1 levels.
+            const int bound = static_cast<int>(std::ceil(std::log2(std::max(1.0, double(n) / leaf)))) + 1;
+            CAPTURE(n);
+            CAPTURE(leaf);
+            CHECK(h.depth() <= bound);
+        }
+    }
+}
+
+TEST_CASE("hierarchy: box queries find exactly what a linear scan finds") {
+    std::mt19937_64 rng(6);
+    const auto segs = random_segments(rng, 3000);
+    const Hierarchy h(segs, 2);
+    std::uniform_real_distribution<double> U(0, 1);
+    std::vector<int32_t> stack;
+    for (int q = 0; q < 50; ++q) {
+        Box query;
+        query.add(Vec2{U(rng), U(rng)});
+        query.add(Vec2{U(rng), U(rng)});
+        std::set<int> found;
+        const long visited = h.query([&](const Box& b) { return overlap(b, query); },
+                                     [&](int s, const Segment& g) {
+                                         Box gb;
+                                         gb.add(g);
+                                         if (overlap(gb, query)) found.insert(s);
+                                     },
+                                     stack);
+        std::set<int> expected;
+        for (size_t s = 0; s < segs.size(); ++s) {
+            Box gb;
+            gb.add(segs[s]);
+            if (overlap(gb, query)) expected.insert(static_cast<int>(s));
+        }
+        CHECK(found == expected);
+        CHECK(visited >= 1);
+    }
+}
+
+TEST_CASE("hierarchy: coincident segments do not split forever") {
+    std::vector<Segment> same(100, Segment{{0, 0}, {1, 1}});
+    const Hierarchy h(same, 2);
+    CHECK(h.nodes().size() == 1);
+    CHECK(h.node(0).count == 100);
+}

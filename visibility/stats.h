@@ -1,0 +1,29 @@
+#pragma once
+/// Counters every visibility method fills in, so that what a query cost (and
+/// what it approximated) is visible in `stats` (DESIGN.md §4).
+namespace flatrad {
+
+struct VisibilityStats {
+    long queries = 0;           ///< occluded exchanges asked for (shaft held a blocker)
+    long unoccluded = 0;        ///< exchanges answered by crossed strings (empty shaft)
+    long culled = 0;            ///< pairs that cannot see each other's lit side
+    long clusters_visited = 0;  ///< hierarchy nodes visited by shaft culling
+    long approximated = 0;      ///< clusters replaced by a mean (0 for exact)
+    long blockers = 0;          ///< blocker pieces found inside shafts
+    long events = 0;            ///< critical directions integrated over
+    long separated = 0;         ///< shafts closed by one blocker (answer 0 at once)
+
+    VisibilityStats& operator+=(const VisibilityStats& o) {
+        queries += o.queries;
+        unoccluded += o.unoccluded;
+        culled += o.culled;
+        clusters_visited += o.clusters_visited;
+        approximated += o.approximated;
+        blockers += o.blockers;
+        events += o.events;
+        separated += o.separated;
+        return *this;
+    }
+};
+
+}  // namespace flatrad
