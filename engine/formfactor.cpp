@@ -2,9 +2,16 @@
 
 #include "engine/error.h"
 
+#include <algorithm>
+#include <limits>
+
 namespace flatrad {
 
 namespace {
+
+// A cut point is computed to a few ulps of the coordinates' size; two cuts
+// closer than 64 ulps of it are the same point.
+constexpr double snap_tolerance = 64 * std::numeric_limits<double>::epsilon();
 
 // |u| - |v| for two nearby vectors without subtracting large lengths:
 // (|u|^2 - |v|^2) / (|u| + |v|), the numerator as (u - v).(u + v) where
@@ -70,6 +77,16 @@ std::optional<std::pair<Segment, Segment>> clip_to_lit_halfplanes(const Segment&
     if (!ci) return std::nullopt;
     auto cj = clip_left(j, i.a, i.b);
     if (!cj) return std::nullopt;
+    // When the two lines cross inside both segments, each is cut at the
+    // crossing, computed twice with different roundings. Make the two cuts
+    // one point, so that the pair is an exact wedge (and the shaft has no
+    // sliver of an edge whose orientation is rounding noise).
+    const double snap = snap_tolerance * (std::max({std::abs(i.a.x), std::abs(i.a.y), std::abs(i.b.x), std::abs(i.b.y),
+                                                    std::abs(j.a.x), std::abs(j.a.y), std::abs(j.b.x), std::abs(j.b.y)}) +
+                                          i.length() + j.length());
+    if (!(ci->a == cj->b) && distance(ci->a, cj->b) <= snap) cj->b = ci->a;
+    if (!(ci->b == cj->a) && distance(ci->b, cj->a) <= snap) cj->a = ci->b;
+    if (ci->a == ci->b || cj->a == cj->b) return std::nullopt;
     return std::make_pair(*ci, *cj);
 }
 

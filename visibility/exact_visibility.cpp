@@ -86,13 +86,20 @@ bool add_blocker(const Shaft& shaft, const Segment& s, double size, std::vector<
     Segment piece;
     int enter = -1, leave = -1;
     if (!shaft.clip(s, piece, enter, leave)) return false;
-    if ((enter == 1 && leave == 3) || (enter == 3 && leave == 1)) return true;
-    // Drop pieces lying along patch i (edge 0) or patch j (edge 2).
+    // Drop pieces lying along patch i (edge 0) or patch j (edge 2); note
+    // whether either end touches a patch's line.
     const double tol = on_edge_tolerance * size * size;
+    bool end_on_patch_line = false;
     for (size_t e : {size_t{0}, size_t{2}}) {
         const Vec2 p = shaft.v[e], q = shaft.v[e + 1];
-        if (orient(p, q, piece.a) <= tol && orient(p, q, piece.b) <= tol) return false;
+        const bool a_on = orient(p, q, piece.a) <= tol, b_on = orient(p, q, piece.b) <= tol;
+        if (a_on && b_on) return false;
+        end_on_patch_line = end_on_patch_line || a_on || b_on;
     }
+    // From side to side closes the shaft; but when a side edge is collinear
+    // with a patch (a clipped corner), the edge labels of Cyrus-Beck cannot
+    // tell the side from the patch, so ends on a patch's line never count.
+    if (!end_on_patch_line && ((enter == 1 && leave == 3) || (enter == 3 && leave == 1))) return true;
     blockers.push_back(piece);
     return false;
 }
@@ -141,6 +148,20 @@ double integrate(const Segment& ci, const Segment& cj, const std::vector<Segment
     }
     const size_t npts = pts.size();
     const size_t nblk = blockers.size();
+    // The blocker endpoints again, one array per coordinate, for the inner
+    // loops over blockers.
+    auto& soa = ws.soa;
+    soa.resize(4 * nblk);
+    double* const bx0 = soa.data();
+    double* const by0 = bx0 + nblk;
+    double* const bx1 = by0 + nblk;
+    double* const by1 = bx1 + nblk;
+    for (size_t q = 0; q < nblk; ++q) {
+        bx0[q] = pts[4 + 2 * q].x;
+        by0[q] = pts[4 + 2 * q].y;
+        bx1[q] = pts[5 + 2 * q].x;
+        by1[q] = pts[5 + 2 * q].y;
+    }
 
     // Range of slopes: the extreme patch-to-patch directions.
     double s_lo = std::numeric_limits<double>::infinity(), s_hi = -s_lo;
@@ -171,6 +192,7 @@ double integrate(const Segment& ci, const Segment& cj, const std::vector<Segment
     dirs.clear();
     dirs.push_back(s_lo);
     dirs.push_back(s_hi);
+    size_t last_hider = nblk;
     for (size_t a = 0; a < npts; ++a) {
         // Pairs inside one patch never matter: i's own direction is outside
         // the range, and so is j's.
@@ -184,6 +206,27 @@ double integrate(const Segment& ci, const Segment& cj, const std::vector<Segment
             const double p = -s * pts[a].x + pts[a].y;
             const double slack = event_slack * (std::abs(hi - lo) + std::abs(p));
             if (p < lo - slack || p > hi + slack) continue;
+            // A swap hidden strictly inside a third blocker's shadow changes
+            // nothing: near (p, s) every line is stopped by that blocker
+            // before and after. Checking the blocker that hid the last one
+            // first makes this cheap in dense shafts.
+            const size_t own_a = a < 4 ? nblk : (a - 4) / 2, own_b = (b - 4) / 2;
+            // (All points lie in the shaft, so their p are of the size of
+            // the overlap and p: `slack` serves as the margin.)
+            auto hides = [&](size_t q) {
+                if (q == own_a || q == own_b) return false;
+                const double da = -s * bx0[q] + by0[q] - p;
+                const double db = -s * bx1[q] + by1[q] - p;
+                return da * db < 0 && std::min(std::abs(da), std::abs(db)) > slack;
+            };
+            if (last_hider < nblk && hides(last_hider)) continue;
+            bool hidden = false;
+            for (size_t q = 0; q < nblk && !hidden; ++q)
+                if (q != last_hider && hides(q)) {
+                    hidden = true;
+                    last_hider = q;
+                }
+            if (hidden) continue;
             dirs.push_back(s);
         }
     }
@@ -204,8 +247,9 @@ double integrate(const Segment& ci, const Segment& cj, const std::vector<Segment
     auto& order = ws.order;
     order.resize(nblk);
     for (size_t k = 0; k < nblk; ++k) order[k] = static_cast<int32_t>(k);
-    auto& iv = ws.intervals;
-    iv.resize(nblk);
+    ws.proj.resize(2 * nblk);
+    double* const iv_start = ws.proj.data();
+    double* const iv_end = iv_start + nblk;
     double total = 0, comp = 0;  // Kahan-compensated sum over arcs
     for (size_t k = 0; k + 1 < dirs.size(); ++k) {
         const double s0 = dirs[k], s1 = dirs[k + 1];
@@ -222,17 +266,20 @@ double integrate(const Segment& ci, const Segment& cj, const std::vector<Segment
         if (!(hi > lo)) continue;
         double blocked = 0;
         if (nblk > 0) {
+            double* const start = iv_start;
+            double* const end = iv_end;
             for (size_t q = 0; q < nblk; ++q) {
-                const double pa = nx * pts[4 + 2 * q].x + ny * pts[4 + 2 * q].y;
-                const double pb = nx * pts[5 + 2 * q].x + ny * pts[5 + 2 * q].y;
-                iv[q] = {std::max(std::min(pa, pb), lo), std::min(std::max(pa, pb), hi)};
+                const double pa = nx * bx0[q] + ny * by0[q];
+                const double pb = nx * bx1[q] + ny * by1[q];
+                start[q] = std::max(std::min(pa, pb), lo);
+                end[q] = std::min(std::max(pa, pb), hi);
             }
             // Insertion sort by start: the order changes little between arcs.
             for (size_t q = 1; q < nblk; ++q) {
                 const int32_t key = order[q];
-                const double ks = iv[static_cast<size_t>(key)].first;
+                const double ks = start[key];
                 size_t r = q;
-                while (r > 0 && iv[static_cast<size_t>(order[r - 1])].first > ks) {
+                while (r > 0 && start[order[r - 1]] > ks) {
                     order[r] = order[r - 1];
                     --r;
                 }
@@ -240,7 +287,7 @@ double integrate(const Segment& ci, const Segment& cj, const std::vector<Segment
             }
             double reach = lo;
             for (size_t q = 0; q < nblk; ++q) {
-                const auto& [bs, be] = iv[static_cast<size_t>(order[q])];
+                const double bs = start[order[q]], be = end[order[q]];
                 if (be <= reach || be <= bs) continue;  // covered already, or outside the overlap
                 blocked += be - std::max(bs, reach);
                 reach = be;

@@ -34,7 +34,7 @@ struct ExactWorkspace {
     std::vector<double> directions;
     std::vector<double> proj;
     std::vector<int32_t> order;
-    std::vector<std::pair<double, double>> intervals;
+    std::vector<double> soa;
 };
 
 class ExactVisibility {

@@ -1,0 +1,236 @@
+#include "cli/cli.h"
+
+#include <algorithm>
+#include <exception>
+#include <new>
+#include <ostream>
+
+#include <CLI/CLI.hpp>
+
+#include "cli/formfactor_command.h"
+#include "cli/solve_command.h"
+#include "cli/usage_error.h"
+#include "engine/error.h"
+
+#ifndef FLATRAD_VERSION
+#define FLATRAD_VERSION "unknown"
+#endif
+
+namespace flatrad {
+
+namespace {
+
+constexpr int exit_ok = 0;
+constexpr int exit_failure = 1;  // anything but bad input
+constexpr int exit_bad_input = 2;
+
+// Errors are one line (SPEC.md, "Exit status"); a stray newline in a
+// message would break that, so it is folded into a space.
+void print_error(std::ostream& err, const std::string& message) {
+    std::string line = message;
+    for (char& c : line)
+        if (c == '\n' || c == '\r') c = ' ';
+    while (!line.empty() && line.back() == ' ') line.pop_back();
+    err << "error: " << line << '\n' << std::flush;
+}
+
+bool is_command(CLI::App& app, const std::string& word) {
+    const auto all = app.get_subcommands([](const CLI::App*) { return true; });
+    return std::any_of(all.begin(), all.end(), [&](const CLI::App* sub) { return sub->check_name(word); });
+}
+
+// What each command's parser fills in.
+struct Commands {
+    SolveArgs solve;
+    CLI::Option* solve_eps = nullptr;
+    CLI::Option* solve_vis_eps = nullptr;
+    FormFactorArgs formfactor;
+    CLI::Option* formfactor_eps = nullptr;
+    double eps_value = 0, vis_eps_value = 0, ff_eps_value = 0;
+
+    CLI::App* solve_cmd = nullptr;
+    CLI::App* formfactor_cmd = nullptr;
+    CLI::App* compare_cmd = nullptr;
+    CLI::App* sweep_cmd = nullptr;
+};
+
+void add_solve(CLI::App& app, Commands& c) {
+    CLI::App* cmd = app.add_subcommand("solve", "Solve a scene; write the result file (stdout without -o).");
+    cmd->footer(
+        "The result file is JSON (SPEC.md \"Result file\"): per patch its radiosity and elements, "
+        "energy totals and stats. A summary goes to stderr unless --quiet.\n"
+        "Exit status: 0 done; 2 bad input or bad arguments (one line on stderr); 1 anything else.");
+    c.solve_cmd = cmd;
+    SolveArgs& a = c.solve;
+    cmd->add_option("SCENE", a.scene, "Scene file (JSON, SPEC.md \"Scene file\").")
+        ->required()
+        ->type_name("FILE");
+    cmd->add_option("-o,--output", a.output,
+                    "Result file to write (JSON). Written through a temporary file and renamed, "
+                    "so it is never half-written; nothing is written if the solve fails. "
+                    "Without -o the result goes to stdout and the summary to stderr.")
+        ->type_name("RESULT.json");
+    cmd->add_option("--method", a.method,
+                    "exact: every patch cut into K equal elements, every pair's exact form factor, "
+                    "one dense linear system (the reference; the default for now). hierarchical: "
+                    "not available yet.")
+        ->type_name("METHOD")
+        ->check(CLI::IsMember({"exact", "hierarchical"}))
+        ->capture_default_str();
+    c.solve_eps = cmd->add_option("--eps", c.eps_value,
+                                  "Refinement tolerance of the hierarchical solver, >= 0. "
+                                  "Ignored by --method exact.")
+                      ->type_name("E");
+    c.solve_vis_eps = cmd->add_option("--vis-eps", c.vis_eps_value,
+                                      "Visibility tolerance of the hierarchical solver (the "
+                                      "paper's epsilon for Gamma), >= 0. Ignored by --method exact.")
+                          ->type_name("E");
+    cmd->add_option("--subdivide", a.subdivide,
+                    "K >= 1: elements per patch for --method exact. The dense matrix needs "
+                    "(patches x K)^2 x 8 bytes; more than 8 GiB is refused.")
+        ->type_name("K")
+        ->capture_default_str();
+    cmd->add_option("--svg", a.svg, "Draw the solution as an SVG picture (not available yet).")
+        ->type_name("OUT.svg");
+    cmd->add_option("--threads", a.threads, "Threads for the form factors; 0: all cores.")
+        ->type_name("N")
+        ->capture_default_str();
+    cmd->add_flag("-q,--quiet", a.quiet, "No summary on stderr.");
+}
+
+void add_formfactor(CLI::App& app, Commands& c) {
+    CLI::App* cmd = app.add_subcommand(
+        "formfactor", "Form factor between two groups of surfaces; prints one JSON object.");
+    cmd->footer(
+        "Prints {from, to, method, eps, F, F_reverse, time_s, clusters_visited, stats} on one line. "
+        "Every segment of the scene is an occluder. F is the length-weighted form factor from A's "
+        "lit patches to B's (a both-sided segment counts twice); F_reverse the same from B to A. "
+        "A and B may name the same surface.\n"
+        "Exit status: 0 done; 2 bad input or bad arguments (one line on stderr); 1 anything else.");
+    c.formfactor_cmd = cmd;
+    FormFactorArgs& a = c.formfactor;
+    cmd->add_option("SCENE", a.scene, "Scene file (JSON).")->required()->type_name("FILE");
+    cmd->add_option("--from", a.from,
+                    "Sending surface name(s); several, separated by commas, form one group.")
+        ->required()
+        ->type_name("A");
+    cmd->add_option("--to", a.to, "Receiving surface name(s), comma-separated as for --from.")
+        ->required()
+        ->type_name("B");
+    cmd->add_option("--method", a.method,
+                    "exact: exact visibility (the default). unoccluded: crossed strings, "
+                    "ignoring every blocker. multiscale: not available yet.")
+        ->type_name("METHOD")
+        ->check(CLI::IsMember({"exact", "unoccluded", "multiscale"}))
+        ->capture_default_str();
+    c.formfactor_eps = cmd->add_option(
+        "--eps", c.ff_eps_value,
+        "Tolerance of --method multiscale, >= 0. Ignored by exact and unoccluded (reported as 0).")
+                              ->type_name("E");
+}
+
+void add_not_yet(CLI::App& app, Commands& c) {
+    c.compare_cmd = app.add_subcommand(
+        "compare", "Hierarchical against exact: error and run time (not available yet).");
+    c.compare_cmd->footer(
+        "Planned: flatrad compare SCENE [--eps E ...]. Not available yet: it needs the "
+        "hierarchical solver. Any arguments are accepted and the command exits with status 2.");
+    c.compare_cmd->allow_extras();
+    c.sweep_cmd = app.add_subcommand(
+        "sweep", "Error against run time over a range of tolerances (not available yet).");
+    c.sweep_cmd->footer(
+        "Planned: a table and a plot of error against run time over a range of tolerances. Not "
+        "available yet: it needs the hierarchical solver and multi-scale visibility. Any "
+        "arguments are accepted and the command exits with status 2.");
+    c.sweep_cmd->allow_extras();
+}
+
+int dispatch(Commands& c, std::ostream& out, std::ostream& err) {
+    if (c.solve_cmd->parsed()) {
+        if (c.solve_eps->count() > 0) c.solve.eps = c.eps_value;
+        if (c.solve_vis_eps->count() > 0) c.solve.vis_eps = c.vis_eps_value;
+        return run_solve(c.solve, out, err);
+    }
+    if (c.formfactor_cmd->parsed()) {
+        if (c.formfactor_eps->count() > 0) c.formfactor.eps = c.ff_eps_value;
+        return run_formfactor(c.formfactor, out, err);
+    }
+    if (c.compare_cmd->parsed())
+        throw UsageError("compare: not available yet (the hierarchical solver has not landed)");
+    if (c.sweep_cmd->parsed())
+        throw UsageError(
+            "sweep: not available yet (the hierarchical solver and the multi-scale visibility "
+            "module have not landed)");
+    throw UsageError("a command is required: solve, formfactor, compare or sweep (see flatrad --help)");
+}
+
+}  // namespace
+
+int run_cli(int argc, char** argv, std::ostream& out, std::ostream& err) {
+    CLI::App app{"flatrad: 2D (flatland) radiosity with an exact-visibility reference solver.",
+                 "flatrad"};
+    app.set_version_flag("--version", std::string("flatrad ") + FLATRAD_VERSION);
+    app.require_subcommand(0, 1);
+    app.footer(
+        "Exit status: 0 done; 2 bad input or bad arguments (one line on stderr); 1 anything else.\n"
+        "Run 'flatrad COMMAND --help' for a command's flags.");
+    Commands commands;
+    add_solve(app, commands);
+    add_formfactor(app, commands);
+    add_not_yet(app, commands);
+
+    // CLI11 would call an unknown command an unexpected argument; say what it is.
+    if (argc > 1 && argv[1][0] != '-' && !is_command(app, argv[1])) {
+        print_error(err, std::string("unknown command \"") + argv[1] +
+                             "\": expected solve, formfactor, compare or sweep (see flatrad --help)");
+        return exit_bad_input;
+    }
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::CallForHelp&) {
+        // The top-level help shows every command's flags too.
+        out << (app.get_subcommands().empty() ? app.help("", CLI::AppFormatMode::All) : app.help());
+        return exit_ok;
+    } catch (const CLI::CallForAllHelp&) {
+        out << app.help("", CLI::AppFormatMode::All);
+        return exit_ok;
+    } catch (const CLI::CallForVersion&) {
+        out << app.version() << '\n';
+        return exit_ok;
+    } catch (const CLI::ParseError& e) {
+        // CLI11's own report spans several lines; ours is one.
+        std::string where = "flatrad";
+        for (const CLI::App* sub : app.get_subcommands()) where += " " + sub->get_name();
+        print_error(err, std::string(e.what()) + " (see " + where + " --help)");
+        return exit_bad_input;
+    }
+
+    try {
+        return dispatch(commands, out, err);
+    } catch (const UsageError& e) {
+        print_error(err, e.what());
+        return exit_bad_input;
+    } catch (const InputError& e) {
+        print_error(err, e.what());  // already "FILE: PATH: MESSAGE"
+        return exit_bad_input;
+    } catch (const std::bad_alloc&) {
+        print_error(err, "out of memory");
+        return exit_failure;
+    } catch (const std::exception& e) {
+        print_error(err, e.what());
+        return exit_failure;
+    }
+}
+
+int run_cli(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
+    std::vector<std::string> storage;
+    storage.reserve(args.size() + 1);
+    storage.emplace_back("flatrad");
+    storage.insert(storage.end(), args.begin(), args.end());
+    std::vector<char*> argv;
+    for (std::string& s : storage) argv.push_back(s.data());
+    argv.push_back(nullptr);
+    return run_cli(static_cast<int>(storage.size()), argv.data(), out, err);
+}
+
+}  // namespace flatrad

@@ -1,0 +1,32 @@
+#pragma once
+/// The result file of SPEC.md ("Result file") and the stats objects, as
+/// JSON. Keys keep the SPEC's order (ordered_json), so the file reads as the
+/// SPEC shows it.
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "engine/scene.h"
+#include "solver/solution.h"
+#include "visibility/stats.h"
+
+namespace flatrad {
+
+/// Every VisibilityStats counter, by its member name.
+nlohmann::ordered_json visibility_stats_json(const VisibilityStats& stats);
+
+/// The whole result file for `solution`, a solve of `scene`:
+/// {flatrad, scene, method, settings, patches, totals, stats}.
+/// Patches come in SPEC numbering (Scene::patches order); `segment` is the
+/// segment's number within its surface, `a` and `b` its points in file order.
+/// Settings hold what shaped the result: `subdivide` always, `eps` and
+/// `vis_eps` for the hierarchical method only (exact ignores them).
+nlohmann::ordered_json result_json(const Scene& scene, const Solution& solution);
+
+/// Text of a result: two-space indented at the top level, each patch on one
+/// line (a patch with many elements is one long line rather than hundreds
+/// of short ones). Doubles print with round-trip precision; a non-finite
+/// value prints as null. Ends with a newline.
+std::string format_result(const nlohmann::ordered_json& result);
+
+}  // namespace flatrad

@@ -1,0 +1,63 @@
+#include "cli/summary.h"
+
+#include <algorithm>
+#include <cstddef>
+#include <numeric>
+#include <ostream>
+#include <vector>
+
+#include <fmt/format.h>
+
+namespace flatrad {
+
+namespace {
+
+// One value as is, several as (r, g, b).
+std::string channels(const std::vector<double>& v) {
+    if (v.size() == 1) return fmt::format("{:.6g}", v[0]);
+    std::string s = "(";
+    for (std::size_t c = 0; c < v.size(); ++c) s += fmt::format("{}{:.6g}", c ? ", " : "", v[c]);
+    return s + ")";
+}
+
+double mean(const std::vector<double>& v) {
+    return v.empty() ? 0.0 : std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
+}
+
+}  // namespace
+
+void print_summary(std::ostream& os, const Scene& scene, const Solution& solution,
+                   const std::string& written_to, int brightest) {
+    const SolveStats& s = solution.stats;
+    os << fmt::format("flatrad: \"{}\" solved by {} (subdivide {}): {} patches, {} elements, {} links\n",
+                      scene.name, solution.method, solution.subdivide, scene.patches.size(),
+                      s.elements, s.links);
+    os << fmt::format("  time {:.4g} s (form factors {:.4g} s, linear solve {:.4g} s, {} thread{})\n",
+                      s.time_s, s.form_factor_time_s, s.linear_solve_time_s, s.threads,
+                      s.threads == 1 ? "" : "s");
+    const Totals& t = solution.totals;
+    os << fmt::format("  energy: emitted {}, absorbed {}, escaped {}, balance {}; residual {:.3g}\n",
+                      channels(t.emitted), channels(t.absorbed), channels(t.escaped),
+                      channels(t.balance), s.residual);
+
+    std::vector<std::size_t> order(std::min(scene.patches.size(), solution.patches.size()));
+    std::iota(order.begin(), order.end(), std::size_t{0});
+    const std::size_t shown = std::min(order.size(), static_cast<std::size_t>(std::max(brightest, 0)));
+    std::partial_sort(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(shown), order.end(),
+                      [&](std::size_t i, std::size_t j) {
+                          return mean(solution.patches[i].radiosity) > mean(solution.patches[j].radiosity);
+                      });
+    if (shown > 0) os << "  brightest patches (radiosity):\n";
+    for (std::size_t k = 0; k < shown; ++k) {
+        const std::size_t p = order[k];
+        const Patch& patch = scene.patches[p];
+        os << fmt::format("    {} segment {} {}: {}\n",
+                          scene.surfaces[static_cast<std::size_t>(patch.surface)].name,
+                          scene.segments[static_cast<std::size_t>(patch.segment)].index,
+                          side_name(patch.side), channels(solution.patches[p].radiosity));
+    }
+    os << (written_to.empty() ? std::string("  result written to stdout\n")
+                              : fmt::format("  result written to {}\n", written_to));
+}
+
+}  // namespace flatrad

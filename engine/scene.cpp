@@ -1,0 +1,741 @@
+#include "engine/scene.h"
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <numbers>
+#include <optional>
+#include <set>
+#include <sstream>
+#include <string_view>
+#include <system_error>
+#include <unordered_map>
+#include <utility>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "engine/error.h"
+
+namespace flatrad {
+
+const char* side_name(Side s) {
+    switch (s) {
+        case Side::Left: return "left";
+        case Side::Right: return "right";
+        case Side::Both: return "both";
+        case Side::In: return "in";
+        case Side::Out: return "out";
+    }
+    return "unknown";
+}
+
+std::vector<Segment> Scene::segment_geometry() const {
+    std::vector<Segment> out;
+    out.reserve(segments.size());
+    for (const SceneSegment& s : segments) out.push_back(s.seg);
+    return out;
+}
+
+int Scene::find_surface(const std::string& surface_name) const {
+    for (size_t i = 0; i < surfaces.size(); ++i)
+        if (surfaces[i].name == surface_name) return static_cast<int>(i);
+    return -1;
+}
+
+double Scene::extent() const {
+    Box box;
+    for (const Surface& s : surfaces)
+        for (Vec2 p : s.points) box.add(p);
+    return box.diagonal();
+}
+
+namespace {
+
+// ordered_json keeps the file's key order, so materials are numbered as written.
+using Json = nlohmann::ordered_json;
+
+/// Largest |coordinate| (and radius) accepted. geometry.h squares lengths and
+/// multiplies coordinate differences without scaling; below 1e100 those stay
+/// far from overflow (1e200 << 1.8e308), above it a legal-looking scene would
+/// turn into infinities inside the kernels.
+constexpr double max_coordinate = 1e100;
+
+/// A circle's segment count is bounded so that a typo (1e9) is refused rather
+/// than exhausting memory; a million segments is far finer than any solver
+/// run needs.
+constexpr double max_circle_segments = 1 << 20;
+
+/// A circle's sagitta must exceed the rounding of its points this many times
+/// (circle_points): a margin of 16 over the worst-case displacement.
+constexpr double circle_rounding_factor = 16.0;
+
+/// The shoelace sum of n cross products of vectors of length <= D rounds with
+/// an error below about n * eps * sum|u||v| (each product rounds once, each
+/// addition once). A twice-area not above this many times that bound has no
+/// trustworthy sign, so the winding (and with it "in" vs "out") is unknown.
+constexpr double winding_rounding_factor = 4.0;
+
+std::string key_path(const std::string& base, std::string_view key) {
+    return base.empty() ? std::string(key) : fmt::format("{}.{}", base, key);
+}
+
+std::string index_path(const std::string& base, size_t i) { return fmt::format("{}[{}]", base, i); }
+
+std::string describe_number(double x) {
+    return std::isfinite(x) ? fmt::format("{}", x) : fmt::format("{} (too large for a double)", x);
+}
+
+std::string shorten(std::string s) {
+    constexpr size_t max_shown = 40;
+    if (s.size() > max_shown) s = s.substr(0, max_shown - 3) + "...";
+    return s;
+}
+
+/// What was found, for "expected X, found Y" messages. Short arrays of
+/// scalars are shown in full (`[1, "a"]`), since that is usually the fault.
+std::string describe(const Json& v, bool nested = false) {
+    switch (v.type()) {
+        case Json::value_t::null: return "null";
+        case Json::value_t::boolean: return v.get<bool>() ? "true" : "false";
+        case Json::value_t::number_integer: return fmt::format("{}", v.get<std::int64_t>());
+        case Json::value_t::number_unsigned: return fmt::format("{}", v.get<std::uint64_t>());
+        case Json::value_t::number_float: return describe_number(v.get<double>());
+        case Json::value_t::string:
+            return nested ? fmt::format("\"{}\"", shorten(v.get<std::string>()))
+                          : fmt::format("the string \"{}\"", shorten(v.get<std::string>()));
+        case Json::value_t::array: {
+            constexpr size_t max_listed = 4;
+            const bool all_scalars = std::all_of(v.begin(), v.end(), [](const Json& e) {
+                return e.is_primitive();
+            });
+            if (nested || v.size() > max_listed || !all_scalars)
+                return v.empty() ? "an empty array"
+                                 : fmt::format("an array of {} item{}", v.size(), v.size() == 1 ? "" : "s");
+            std::string out = "[";
+            for (size_t i = 0; i < v.size(); ++i) out += (i ? ", " : "") + describe(v[i], true);
+            return out + "]";
+        }
+        case Json::value_t::object: return "an object";
+        case Json::value_t::binary: return "binary data";
+        case Json::value_t::discarded: return "nothing";
+    }
+    return "something unknown";
+}
+
+/// 1-based line and column of the character at 0-based `offset` in `text`.
+std::pair<size_t, size_t> line_column(const std::string& text, size_t offset) {
+    offset = std::min(offset, text.size());
+    size_t line = 1, line_start = 0;
+    for (size_t i = 0; i < offset; ++i)
+        if (text[i] == '\n') {
+            ++line;
+            line_start = i + 1;
+        }
+    return {line, offset - line_start + 1};
+}
+
+/// nlohmann's message without its "[json.exception...] parse error at ...: "
+/// prefix (we print our own position).
+std::string parser_reason(const std::string& what) {
+    const size_t at = what.find("parse error");
+    if (at != std::string::npos) {
+        const size_t colon = what.find(": ", at);
+        if (colon != std::string::npos) return what.substr(colon + 2);
+    }
+    const size_t bracket = what.find("] ");
+    return bracket == std::string::npos ? what : what.substr(bracket + 2);
+}
+
+/// Parses the text into a DOM, refusing what plain JSON parsing would let
+/// through or report without a place:
+///  - a key repeated in one object (nlohmann would silently keep one of them,
+///    so half of what the user wrote would be ignored);
+///  - a number too large for a double (nlohmann throws out_of_range 406
+///    without a position).
+/// Both need the JSON path of the place being parsed, which the parse
+/// callback lets us track: one frame per open object or array.
+Json parse_json(const std::string& text, const std::string& file) {
+    struct Frame {
+        bool is_object = false;
+        std::set<std::string> keys;  // object: keys seen so far
+        std::string key;             // object: key of the value being parsed
+        size_t index = 0;            // array: index of the value being parsed
+    };
+    std::vector<Frame> stack;
+    const auto current_path = [&stack] {
+        std::string path;
+        for (const Frame& f : stack) path = f.is_object ? key_path(path, f.key) : index_path(path, f.index);
+        return path;
+    };
+    const auto value_done = [&stack] {
+        if (!stack.empty() && !stack.back().is_object) ++stack.back().index;
+    };
+    const Json::parser_callback_t callback = [&](int, Json::parse_event_t event, Json& parsed) {
+        switch (event) {
+            case Json::parse_event_t::object_start: stack.push_back(Frame{true, {}, {}, 0}); break;
+            case Json::parse_event_t::array_start: stack.push_back(Frame{false, {}, {}, 0}); break;
+            case Json::parse_event_t::key: {
+                Frame& top = stack.back();
+                top.key = parsed.get<std::string>();
+                if (!top.keys.insert(top.key).second)
+                    throw InputError(file, current_path(),
+                                     fmt::format("duplicate key \"{}\": each key may appear once per object",
+                                                 shorten(top.key)));
+                break;
+            }
+            case Json::parse_event_t::object_end:
+            case Json::parse_event_t::array_end:
+                stack.pop_back();
+                value_done();
+                break;
+            case Json::parse_event_t::value: value_done(); break;
+        }
+        return true;
+    };
+
+    try {
+        return Json::parse(text, callback);
+    } catch (const Json::parse_error& e) {
+        // e.byte counts the characters read, the offending one included.
+        const auto [line, column] = line_column(text, e.byte > 0 ? e.byte - 1 : 0);
+        throw InputError(file, "", fmt::format("malformed JSON at line {}, column {}: {}", line, column,
+                                               parser_reason(e.what())));
+    } catch (const Json::out_of_range& e) {
+        if (e.id != 406) throw;
+        // "number overflow parsing '1e999'": the number is the value being
+        // parsed in the innermost open object or array.
+        const std::string what = e.what();
+        const size_t open = what.find('\''), close = what.rfind('\'');
+        const std::string token =
+            open != std::string::npos && close > open ? what.substr(open + 1, close - open - 1) : "a number";
+        throw InputError(file, current_path(),
+                         fmt::format("expected a finite number, found {} (too large for a double)", shorten(token)));
+    }
+}
+
+/// Which range a channel value must lie in.
+enum class ChannelKind { Reflectance, Emission };
+
+/// Reads a parsed document into a Scene, or throws InputError at the first
+/// fault in file order. Nothing is kept from a document that fails.
+class SceneReader {
+public:
+    explicit SceneReader(const std::string& file) : m_file(file) {}
+
+    Scene read(const Json& root) {
+        Scene scene;
+        scene.file = m_file;
+        if (!root.is_object())
+            fail("", fmt::format("expected a JSON object {{\"flatrad\": 1, \"materials\": ..., \"surfaces\": ...}}, "
+                                 "found {}",
+                                 describe(root)));
+
+        const Json& version = require(root, "flatrad", "");
+        if (!version.is_number() || version.get<double>() != 1.0)
+            fail("flatrad", fmt::format("expected the format version 1, found {}", describe(version)));
+
+        if (const Json* name = optional(root, "name")) {
+            if (!name->is_string()) fail("name", fmt::format("expected a string, found {}", describe(*name)));
+            scene.name = name->get<std::string>();
+        } else {
+            scene.name = std::filesystem::path(m_file).stem().string();
+        }
+
+        read_materials(require(root, "materials", ""), scene);
+        read_surfaces(require(root, "surfaces", ""), scene);
+        return scene;
+    }
+
+private:
+    [[noreturn]] void fail(const std::string& path, const std::string& message) const {
+        throw InputError(m_file, path, message);
+    }
+
+    const Json& require(const Json& object, const char* key, const std::string& object_path) const {
+        const auto it = object.find(key);
+        if (it == object.end()) fail(key_path(object_path, key), "missing required key");
+        return *it;
+    }
+
+    static const Json* optional(const Json& object, const char* key) {
+        const auto it = object.find(key);
+        return it == object.end() ? nullptr : &*it;
+    }
+
+    double finite_number(const Json& v, const std::string& path, std::string_view expected) const {
+        if (!v.is_number() || !std::isfinite(v.get<double>()))
+            fail(path, fmt::format("expected {}, found {}", expected, describe(v)));
+        return v.get<double>();
+    }
+
+    // ---- materials -------------------------------------------------------
+
+    void read_materials(const Json& materials, Scene& scene) {
+        if (!materials.is_object())
+            fail("materials", fmt::format("expected an object mapping names to {{\"reflectance\", \"emission\"}}, "
+                                          "found {}",
+                                          describe(materials)));
+
+        // Read every value as written; scalars are broadcast once the channel
+        // count (the common length of all arrays) is known.
+        struct Raw {
+            std::vector<double> reflectance, emission;
+        };
+        std::vector<Raw> raw;
+        for (const auto& item : materials.items()) {
+            const std::string path = key_path("materials", item.key());
+            const Json& m = item.value();
+            if (!m.is_object())
+                fail(path, fmt::format("expected an object {{\"reflectance\": ..., \"emission\": ...}}, found {}",
+                                       describe(m)));
+            Material material;
+            material.name = item.key();
+            scene.materials.push_back(material);
+            Raw values;
+            if (const Json* r = optional(m, "reflectance"))
+                values.reflectance = read_channels(*r, key_path(path, "reflectance"), ChannelKind::Reflectance);
+            if (const Json* e = optional(m, "emission"))
+                values.emission = read_channels(*e, key_path(path, "emission"), ChannelKind::Emission);
+            raw.push_back(std::move(values));
+        }
+
+        scene.channels = static_cast<int>(m_channels.value_or(1));
+        const auto broadcast = [&scene](const std::vector<double>& v) {
+            if (v.empty()) return std::vector<double>(static_cast<size_t>(scene.channels), 0.0);  // default 0
+            if (v.size() == 1) return std::vector<double>(static_cast<size_t>(scene.channels), v[0]);
+            return v;
+        };
+        for (size_t i = 0; i < raw.size(); ++i) {
+            scene.materials[i].reflectance = broadcast(raw[i].reflectance);
+            scene.materials[i].emission = broadcast(raw[i].emission);
+        }
+    }
+
+    /// A number or an array of 1 or 3 numbers, each in range. Returns a
+    /// single value for a number (to be broadcast) and the array otherwise.
+    std::vector<double> read_channels(const Json& v, const std::string& path, ChannelKind kind) {
+        const auto check_range = [&](double x, const std::string& at) {
+            if (kind == ChannelKind::Reflectance && !(x >= 0.0 && x <= 1.0))
+                fail(at, fmt::format("expected a reflectance in [0, 1], found {}", describe_number(x)));
+            if (kind == ChannelKind::Emission && !(x >= 0.0))
+                fail(at, fmt::format("expected an emission >= 0, found {}", describe_number(x)));
+        };
+        const std::string_view what =
+            kind == ChannelKind::Reflectance ? "a finite reflectance" : "a finite emission";
+
+        if (v.is_number()) {
+            const double x = finite_number(v, path, what);
+            check_range(x, path);
+            return {x};
+        }
+        if (!v.is_array())
+            fail(path, fmt::format("expected a number or an array of 1 or 3 channel values, found {}", describe(v)));
+        if (v.size() != 1 && v.size() != 3)
+            fail(path, fmt::format("expected 1 or 3 channel values, found {}", describe(v)));
+        std::vector<double> values;
+        for (size_t c = 0; c < v.size(); ++c) {
+            const std::string at = index_path(path, c);
+            const double x = finite_number(v[c], at, what);
+            check_range(x, at);
+            values.push_back(x);
+        }
+        // Every array in a scene has the same length (SPEC, "Scene file").
+        if (!m_channels) {
+            m_channels = v.size();
+            m_channels_path = path;
+        } else if (*m_channels != v.size()) {
+            fail(path, fmt::format("expected {} channel values like {}, found {}", *m_channels, m_channels_path,
+                                   v.size()));
+        }
+        return values;
+    }
+
+    // ---- surfaces --------------------------------------------------------
+
+    void read_surfaces(const Json& surfaces, Scene& scene) const {
+        if (!surfaces.is_array())
+            fail("surfaces", fmt::format("expected an array of surfaces, found {}", describe(surfaces)));
+        if (surfaces.empty()) fail("surfaces", "a scene needs at least one surface, found an empty array");
+
+        std::unordered_map<std::string, size_t> material_index;
+        for (size_t m = 0; m < scene.materials.size(); ++m) material_index.emplace(scene.materials[m].name, m);
+        std::unordered_map<std::string, size_t> seen_names;
+
+        for (size_t i = 0; i < surfaces.size(); ++i) {
+            const std::string path = index_path("surfaces", i);
+            const Json& s = surfaces[i];
+            if (!s.is_object())
+                fail(path, fmt::format("expected a surface object {{\"name\", \"material\", \"points\" or "
+                                       "\"circle\", ...}}, found {}",
+                                       describe(s)));
+            Surface surface;
+
+            // Name, unique in the scene.
+            const Json& name = require(s, "name", path);
+            if (!name.is_string() || name.get<std::string>().empty())
+                fail(key_path(path, "name"), fmt::format("expected a non-empty string, found {}", describe(name)));
+            surface.name = name.get<std::string>();
+            if (const auto [it, inserted] = seen_names.emplace(surface.name, i); !inserted)
+                fail(key_path(path, "name"), fmt::format("duplicate surface name \"{}\" (also surfaces[{}])",
+                                                         shorten(surface.name), it->second));
+
+            // Material, by name.
+            const Json& material = require(s, "material", path);
+            if (!material.is_string())
+                fail(key_path(path, "material"),
+                     fmt::format("expected a material name (a string), found {}", describe(material)));
+            const auto found = material_index.find(material.get<std::string>());
+            if (found == material_index.end())
+                fail(key_path(path, "material"), fmt::format("unknown material \"{}\"; known: {}",
+                                                             shorten(material.get<std::string>()),
+                                                             known_materials(scene)));
+            surface.material = static_cast<int>(found->second);
+
+            // Shape: points or circle, never both.
+            const Json* points = optional(s, "points");
+            const Json* circle = optional(s, "circle");
+            if (points && circle) fail(path, "expected either \"points\" or \"circle\", found both");
+            if (!points && !circle)
+                fail(key_path(path, "points"), "missing required key (a surface needs \"points\" or \"circle\")");
+            surface.is_circle = circle != nullptr;
+
+            if (const Json* closed = optional(s, "closed")) {
+                if (!closed->is_boolean())
+                    fail(key_path(path, "closed"), fmt::format("expected true or false, found {}", describe(*closed)));
+                if (surface.is_circle && !closed->get<bool>())
+                    fail(key_path(path, "closed"), "a circle is always closed, found false");
+                surface.closed = closed->get<bool>();
+            }
+            if (surface.is_circle) surface.closed = true;
+
+            surface.side = read_side(s, path, surface.closed);
+            surface.points = surface.is_circle ? circle_points(*circle, key_path(path, "circle"))
+                                               : polyline_points(*points, key_path(path, "points"), surface.closed);
+
+            // Winding: which geometric side of a segment is "in". A circle is
+            // counter-clockwise by construction.
+            bool counter_clockwise = true;
+            if (surface.closed && !surface.is_circle)
+                counter_clockwise = polygon_winding(surface.points, key_path(path, "points"), surface.side);
+
+            add_segments_and_patches(surface, static_cast<int>(i), counter_clockwise, scene);
+            scene.surfaces.push_back(std::move(surface));
+        }
+    }
+
+    static std::string known_materials(const Scene& scene) {
+        if (scene.materials.empty()) return "none";
+        std::string out;
+        for (const Material& m : scene.materials) out += (out.empty() ? "" : ", ") + m.name;
+        return shorten(out);
+    }
+
+    Side read_side(const Json& s, const std::string& path, bool closed) const {
+        const std::string at = key_path(path, "side");
+        const Json* side = optional(s, "side");
+        if (!side) {
+            if (closed) fail(at, "missing required key (a closed shape needs \"side\": \"in\", \"out\" or \"both\")");
+            return Side::Left;
+        }
+        if (!side->is_string())
+            fail(at, fmt::format("expected one of \"left\", \"right\", \"both\", \"in\", \"out\", found {}",
+                                 describe(*side)));
+        const std::string word = side->get<std::string>();
+        Side value;
+        if (word == "left") value = Side::Left;
+        else if (word == "right") value = Side::Right;
+        else if (word == "both") value = Side::Both;
+        else if (word == "in") value = Side::In;
+        else if (word == "out") value = Side::Out;
+        else
+            fail(at, fmt::format("expected one of \"left\", \"right\", \"both\", \"in\", \"out\", found {}",
+                                 describe(*side)));
+
+        if (closed && (value == Side::Left || value == Side::Right))
+            fail(at, fmt::format("a closed shape is lit \"in\", \"out\" or \"both\", found \"{}\"", word));
+        if (!closed && (value == Side::In || value == Side::Out))
+            fail(at, fmt::format("an open polyline is lit \"left\", \"right\" or \"both\", found \"{}\" "
+                                 "(add \"closed\": true for a polygon)",
+                                 word));
+        return value;
+    }
+
+    Vec2 read_point(const Json& v, const std::string& path) const {
+        const auto bad = [&] { fail(path, fmt::format("expected [x, y] with finite numbers, found {}", describe(v))); };
+        if (!v.is_array() || v.size() != 2 || !v[0].is_number() || !v[1].is_number()) bad();
+        const Vec2 p{v[0].get<double>(), v[1].get<double>()};
+        if (!std::isfinite(p.x) || !std::isfinite(p.y)) bad();
+        if (std::abs(p.x) > max_coordinate || std::abs(p.y) > max_coordinate)
+            fail(path, fmt::format("expected coordinates within +-{:g}, found {}", max_coordinate, describe(v)));
+        return p;
+    }
+
+    /// Points of a polyline or polygon, a closing repeat dropped, every
+    /// segment of non-zero length.
+    std::vector<Vec2> polyline_points(const Json& v, const std::string& path, bool closed) const {
+        if (!v.is_array()) fail(path, fmt::format("expected an array of [x, y] points, found {}", describe(v)));
+        std::vector<Vec2> points;
+        points.reserve(v.size());
+        for (size_t k = 0; k < v.size(); ++k) points.push_back(read_point(v[k], index_path(path, k)));
+
+        // A closed shape may repeat its first point at the end; read it as absent.
+        if (closed && points.size() >= 2 && points.back() == points.front()) points.pop_back();
+        if (!closed && points.size() < 2)
+            fail(path, fmt::format("expected at least two points, found {}", points.size()));
+        if (closed && points.size() < 3)
+            fail(path, fmt::format("a closed shape needs at least three points (a last point equal to the first "
+                                   "does not count), found {}",
+                                   points.size()));
+
+        // Zero-length segments. Distinct points can still be too close for a
+        // length (the squared difference underflows), which is as bad.
+        for (size_t k = 1; k < points.size(); ++k)
+            if (!(distance(points[k - 1], points[k]) > 0))
+                fail(index_path(path, k),
+                     points[k] == points[k - 1]
+                         ? fmt::format("zero-length segment: point {} equals point {}", k, k - 1)
+                         : fmt::format("segment from point {} is too short to measure", k - 1));
+        if (closed && !(distance(points.back(), points.front()) > 0))
+            fail(index_path(path, points.size() - 1),
+                 fmt::format("zero-length closing segment: point {} equals point 0 (only one closing repeat is "
+                             "dropped)",
+                             points.size() - 1));
+        return points;
+    }
+
+    /// Points c + r (cos(2 pi k / n), sin(2 pi k / n)), k = 0..n-1:
+    /// counter-clockwise from angle 0 (SPEC).
+    std::vector<Vec2> circle_points(const Json& circle, const std::string& path) const {
+        if (!circle.is_object())
+            fail(path, fmt::format("expected {{\"center\": [x, y], \"radius\": r, \"segments\": n}}, found {}",
+                                   describe(circle)));
+        const Vec2 center = read_point(require(circle, "center", path), key_path(path, "center"));
+
+        const std::string radius_path = key_path(path, "radius");
+        const double radius = finite_number(require(circle, "radius", path), radius_path, "a finite radius > 0");
+        if (!(radius > 0)) fail(radius_path, fmt::format("expected a radius > 0, found {}", describe_number(radius)));
+        if (radius > max_coordinate)
+            fail(radius_path, fmt::format("expected a radius up to {:g}, found {}", max_coordinate, radius));
+
+        const std::string segments_path = key_path(path, "segments");
+        const double n_real = finite_number(require(circle, "segments", path), segments_path,
+                                            "a whole number of segments >= 3");
+        if (std::floor(n_real) != n_real || n_real < 3)
+            fail(segments_path,
+                 fmt::format("expected a whole number of segments >= 3, found {}", describe_number(n_real)));
+        if (n_real > max_circle_segments)
+            fail(segments_path, fmt::format("expected at most {} segments, found {}",
+                                            static_cast<long>(max_circle_segments), describe_number(n_real)));
+        const int n = static_cast<int>(n_real);
+
+        // Rounding the points to doubles moves each by up to about
+        // eps * max(|center|, radius). While that stays well below the
+        // sagitta r (1 - cos(2 pi / n)) (how far a point sits off the chord
+        // of its neighbours) the polygon stays convex, hence simple and
+        // counter-clockwise; beyond it, a tiny circle far from the origin
+        // could come out flattened or tangled.
+        const double s = std::sin(std::numbers::pi / n);
+        const double sagitta = 2 * radius * s * s;
+        const double rounding = std::numeric_limits<double>::epsilon() *
+                                std::max({std::abs(center.x), std::abs(center.y), radius});
+        if (!(sagitta > circle_rounding_factor * rounding))
+            fail(path, fmt::format("radius {} is too small for {} segments around center [{}, {}]: rounding "
+                                   "would distort the polygon (use fewer segments, or move the scene nearer "
+                                   "the origin)",
+                                   radius, n, center.x, center.y));
+
+        std::vector<Vec2> points;
+        points.reserve(static_cast<size_t>(n));
+        for (int k = 0; k < n; ++k) points.push_back(center + radius * unit_circle_point(k, n));
+        return points;
+    }
+
+    /// Point k of n on the unit circle. Quarter turns are exact (cos(pi/2)
+    /// would round to 6e-17), so a circle with n divisible by 4 stays
+    /// mirror-symmetric about both axes where it matters most.
+    static Vec2 unit_circle_point(int k, int n) {
+        const long quarter = 4L * k;
+        if (quarter % n == 0) {
+            switch (quarter / n) {
+                case 0: return {1, 0};
+                case 1: return {0, 1};
+                case 2: return {-1, 0};
+                case 3: return {0, -1};
+                default: break;
+            }
+        }
+        const double angle = 2 * std::numbers::pi * k / n;
+        return {std::cos(angle), std::sin(angle)};
+    }
+
+    /// True when the closed polygon winds counter-clockwise (positive
+    /// shoelace area), so that its interior is on the left of travel.
+    /// For side in/out the polygon must be simple with an area whose sign
+    /// survives rounding; for "both" nothing is required and a zero or
+    /// unreliable area counts as counter-clockwise (only the in/out labels of
+    /// the two patches depend on it).
+    bool polygon_winding(const std::vector<Vec2>& p, const std::string& path, Side side) const {
+        // Shoelace sum about p[0]: small vectors, less cancellation.
+        double twice_area = 0, rounding = 0;
+        for (size_t k = 1; k + 1 < p.size(); ++k) {
+            const Vec2 u = p[k] - p[0], v = p[k + 1] - p[0];
+            twice_area += cross(u, v);
+            rounding += norm(u) * norm(v);
+        }
+        if (side == Side::Both) return twice_area >= 0;
+
+        const double bound = winding_rounding_factor * static_cast<double>(p.size()) *
+                             std::numeric_limits<double>::epsilon() * rounding;
+        if (!(std::abs(twice_area) > bound))
+            fail(path, fmt::format("side \"{}\" needs a simple polygon of non-zero area; these points enclose "
+                                   "none (or too little to tell inside from outside)",
+                                   side_name(side)));
+        check_simple(p, path, side);
+        return twice_area > 0;
+    }
+
+    /// Refuses a polygon that crosses or touches itself: non-neighbouring
+    /// edges must not meet at all, neighbouring edges only at their shared
+    /// vertex (a fold back along the same line counts as touching).
+    /// Broad phase: edges sorted by their left end and swept in x; the
+    /// exact-ish orientation tests then decide. Worst case O(n^2) (many edges
+    /// spanning the whole x range), typically near O(n log n).
+    void check_simple(const std::vector<Vec2>& p, const std::string& path, Side side) const {
+        const size_t n = p.size();
+        struct Edge {
+            Box box;
+            size_t index;
+        };
+        std::vector<Edge> edges;
+        edges.reserve(n);
+        for (size_t k = 0; k < n; ++k) {
+            Edge e{{}, k};
+            e.box.add(p[k]);
+            e.box.add(p[(k + 1) % n]);
+            edges.push_back(e);
+        }
+        std::sort(edges.begin(), edges.end(), [](const Edge& a, const Edge& b) { return a.box.lo.x < b.box.lo.x; });
+
+        const auto edge_name = [n](size_t k) { return fmt::format("segment {} (points {} -> {})", k, k, (k + 1) % n); };
+        for (size_t a = 0; a < n; ++a) {
+            for (size_t b = a + 1; b < n && edges[b].box.lo.x <= edges[a].box.hi.x; ++b) {
+                if (edges[b].box.lo.y > edges[a].box.hi.y || edges[a].box.lo.y > edges[b].box.hi.y) continue;
+                const size_t i = std::min(edges[a].index, edges[b].index);
+                const size_t j = std::max(edges[a].index, edges[b].index);
+                const Vec2 a0 = p[i], a1 = p[(i + 1) % n], b0 = p[j], b1 = p[(j + 1) % n];
+                bool bad = false;
+                if (j == i + 1) bad = folds_back(a0, a1, b1);           // share a1 == b0
+                else if (i == 0 && j == n - 1) bad = folds_back(a1, a0, b0);  // share a0 == b1
+                else bad = segments_meet(a0, a1, b0, b1);
+                if (bad)
+                    fail(path, fmt::format("side \"{}\" needs a simple polygon, but {} meets {}", side_name(side),
+                                           edge_name(i), edge_name(j)));
+            }
+        }
+    }
+
+    /// Neighbouring edges u -> v and v -> w overlap beyond v when w lies on the
+    /// line through u and v on the same side of v as u.
+    static bool folds_back(Vec2 u, Vec2 v, Vec2 w) { return orient(u, v, w) == 0 && dot(u - v, w - v) > 0; }
+
+    /// p lies in the bounding box of [a, b] (enough once p is known to be on its line).
+    static bool within(Vec2 a, Vec2 b, Vec2 p) {
+        return std::min(a.x, b.x) <= p.x && p.x <= std::max(a.x, b.x) && std::min(a.y, b.y) <= p.y &&
+               p.y <= std::max(a.y, b.y);
+    }
+
+    /// Closed segments [a, b] and [c, d] share at least one point: a proper
+    /// crossing, or an endpoint of one lying on the other.
+    static bool segments_meet(Vec2 a, Vec2 b, Vec2 c, Vec2 d) {
+        const double o1 = orient(a, b, c), o2 = orient(a, b, d);
+        const double o3 = orient(c, d, a), o4 = orient(c, d, b);
+        const auto opposite = [](double x, double y) { return (x < 0 && y > 0) || (x > 0 && y < 0); };
+        if (opposite(o1, o2) && opposite(o3, o4)) return true;
+        return (o1 == 0 && within(a, b, c)) || (o2 == 0 && within(a, b, d)) || (o3 == 0 && within(c, d, a)) ||
+               (o4 == 0 && within(c, d, b));
+    }
+
+    /// Appends the surface's segments and patches in SPEC numbering: segment
+    /// by segment in point order (closing segment last), and per segment the
+    /// left (or in) patch before the right (or out) one.
+    static void add_segments_and_patches(Surface& surface, int surface_index, bool counter_clockwise, Scene& scene) {
+        const size_t n = surface.points.size();
+        const size_t count = surface.closed ? n : n - 1;
+
+        // Which geometric side each side word lights. For a closed shape the
+        // interior is on the left of travel when it winds counter-clockwise.
+        const bool in_is_left = counter_clockwise;
+        bool lit_left = false, lit_right = false;
+        switch (surface.side) {
+            case Side::Left: lit_left = true; break;
+            case Side::Right: lit_right = true; break;
+            case Side::Both: lit_left = lit_right = true; break;
+            case Side::In: (in_is_left ? lit_left : lit_right) = true; break;
+            case Side::Out: (in_is_left ? lit_right : lit_left) = true; break;
+        }
+
+        surface.first_segment = static_cast<int>(scene.segments.size());
+        surface.segment_count = static_cast<int>(count);
+        for (size_t k = 0; k < count; ++k) {
+            SceneSegment s;
+            s.seg = {surface.points[k], surface.points[(k + 1) % n]};
+            s.surface = surface_index;
+            s.index = static_cast<int>(k);
+            s.lit_left = lit_left;
+            s.lit_right = lit_right;
+            const int segment_index = static_cast<int>(scene.segments.size());
+            scene.segments.push_back(s);
+
+            const auto add_patch = [&](bool left) {
+                Patch patch;
+                patch.segment = segment_index;
+                patch.surface = surface_index;
+                patch.material = surface.material;
+                patch.lit_left = left;
+                patch.side = surface.closed ? (left == in_is_left ? Side::In : Side::Out)
+                                            : (left ? Side::Left : Side::Right);
+                patch.length = s.seg.length();
+                scene.patches.push_back(patch);
+            };
+            // "Left (or in) before right (or out)": for a clockwise polygon the
+            // in patch is the right one, so it comes first.
+            const bool first_left = surface.closed ? in_is_left : true;
+            if (first_left ? lit_left : lit_right) add_patch(first_left);
+            if (first_left ? lit_right : lit_left) add_patch(!first_left);
+        }
+    }
+
+    const std::string& m_file;
+    std::optional<size_t> m_channels;  // length of the first channel array seen
+    std::string m_channels_path;       // where it was seen, for messages
+};
+
+}  // namespace
+
+Scene parse_scene(const std::string& json_text, const std::string& file_label) {
+    const Json root = parse_json(json_text, file_label);
+    return SceneReader(file_label).read(root);
+}
+
+Scene load_scene(const std::string& path) {
+    std::error_code ec;
+    if (std::filesystem::is_directory(path, ec))
+        throw InputError(path, "", "cannot read the scene file: it is a directory");
+    std::ifstream in(path, std::ios::binary);
+    if (!in) {
+        const int err = errno;
+        throw InputError(path, "", fmt::format("cannot open the scene file: {}",
+                                               std::generic_category().message(err)));
+    }
+    std::ostringstream text;
+    text << in.rdbuf();  // an empty file sets failbit on `text`; the parser reports it
+    if (in.bad()) throw InputError(path, "", "cannot read the scene file: read error");
+    return parse_scene(text.str(), path);
+}
+
+}  // namespace flatrad
