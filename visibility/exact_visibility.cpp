@@ -302,6 +302,71 @@ double integrate(const Segment& ci, const Segment& cj, const std::vector<Segment
     return total / 2;
 }
 
+// Shafts holding more than this many blocker pieces are split in two (the
+// longer patch halved) before integrating: the critical directions grow as
+// the square of the pieces, and halves hold fewer pieces, see a narrower
+// range of directions and are often closed by one blocker. Measured on the
+// 1840-patch room benchmark; any value gives the same answer.
+constexpr size_t split_threshold = 16;
+// A split whose halves keep more than this share of the pieces stops.
+constexpr double split_keep_ratio = 0.8;
+// Depth cap of the splitting (2^12 sub-shafts at most per pair).
+constexpr int max_split_depth = 12;
+
+// L_i F_ij for a mutually facing pair (ci, cj) whose shaft contains no
+// blocker piece other than `candidates` (pieces of the parent shaft).
+double solve_shaft(const Segment& ci, const Segment& cj, const Segment* candidates, size_t count, int depth,
+                   ExactWorkspace& ws, VisibilityStats& stats) {
+    // `count` is also the parent's number of pieces: a split that kept most
+    // of them did not pay, so this level integrates instead of splitting on.
+    const Shaft shaft(ci, cj);
+    const double size = shaft.box.diagonal();
+    auto& mine = ws.levels[static_cast<size_t>(depth)];
+    mine.clear();
+    for (size_t k = 0; k < count; ++k) {
+        Box bb;
+        bb.add(candidates[k]);
+        if (!shaft.overlaps(bb)) continue;
+        if (add_blocker(shaft, candidates[k], size, mine)) {
+            ++stats.separated;
+            return 0;
+        }
+    }
+    if (mine.empty()) return exchange_crossed_strings(ci, cj);
+    const bool no_progress = depth > 0 && static_cast<double>(mine.size()) > split_keep_ratio * static_cast<double>(count);
+    if (mine.size() <= split_threshold || depth == max_split_depth || no_progress) {
+        stats.blockers += static_cast<long>(mine.size());
+        return integrate(ci, cj, mine, ws, stats);
+    }
+    // Split one patch at its midpoint; the halves' shafts lie inside this
+    // one, so this shaft's pieces are all they can meet. Which patch: a piece
+    // at relative position t along the shaft (0 at i, 1 at j) stays in a half
+    // of i's shaft with odds about the half-shaft's width over the shaft's
+    // width there, ((1-t) L_i / 2 + t L_j) / ((1-t) L_i + t L_j); halve the
+    // patch that leaves fewer pieces by that count.
+    ++stats.subshafts;
+    const Segment* pieces = mine.data();
+    const size_t n = mine.size();
+    const double Li = ci.length(), Lj = cj.length();
+    const Vec2 mi = ci.midpoint(), axis = cj.midpoint() - mi;
+    const double axis2 = norm_squared(axis);
+    double keep_i = 0, keep_j = 0;
+    for (size_t k = 0; k < n; ++k) {
+        const double t = std::clamp(dot(pieces[k].midpoint() - mi, axis) / axis2, 0.0, 1.0);
+        const double w = (1 - t) * Li + t * Lj;
+        keep_i += ((1 - t) * Li / 2 + t * Lj) / w;
+        keep_j += ((1 - t) * Li + t * Lj / 2) / w;
+    }
+    if (keep_i <= keep_j) {
+        const Vec2 m = ci.midpoint();
+        return solve_shaft({ci.a, m}, cj, pieces, n, depth + 1, ws, stats) +
+               solve_shaft({m, ci.b}, cj, pieces, n, depth + 1, ws, stats);
+    }
+    const Vec2 m = cj.midpoint();
+    return solve_shaft(ci, {cj.a, m}, pieces, n, depth + 1, ws, stats) +
+           solve_shaft(ci, {m, cj.b}, pieces, n, depth + 1, ws, stats);
+}
+
 }  // namespace
 
 double ExactVisibility::exchange(const Segment& i, const Segment& j, int skip_i, int skip_j, ExactWorkspace& ws,
@@ -333,8 +398,8 @@ double ExactVisibility::exchange(const Segment& i, const Segment& j, int skip_i,
         return exchange_crossed_strings(ci, cj);
     }
     ++stats.queries;
-    stats.blockers += static_cast<long>(ws.blockers.size());
-    return integrate(ci, cj, ws.blockers, ws, stats);
+    ws.levels.resize(max_split_depth + 1);
+    return solve_shaft(ci, cj, ws.blockers.data(), ws.blockers.size(), 0, ws, stats);
 }
 
 double ExactVisibility::exchange_with_blockers(const Segment& i, const Segment& j, const std::vector<Segment>& blockers,
@@ -361,8 +426,8 @@ double ExactVisibility::exchange_with_blockers(const Segment& i, const Segment& 
         return exchange_crossed_strings(ci, cj);
     }
     ++stats.queries;
-    stats.blockers += static_cast<long>(ws.blockers.size());
-    return integrate(ci, cj, ws.blockers, ws, stats);
+    ws.levels.resize(max_split_depth + 1);
+    return solve_shaft(ci, cj, ws.blockers.data(), ws.blockers.size(), 0, ws, stats);
 }
 
 }  // namespace flatrad

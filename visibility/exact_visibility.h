@@ -30,6 +30,7 @@ namespace flatrad {
 struct ExactWorkspace {
     std::vector<int32_t> stack;
     std::vector<Segment> blockers;
+    std::vector<std::vector<Segment>> levels;  // blocker pieces per sub-shaft depth
     std::vector<Vec2> points;
     std::vector<double> directions;
     std::vector<double> proj;

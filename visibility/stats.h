@@ -11,7 +11,8 @@ struct VisibilityStats {
     long approximated = 0;      ///< clusters replaced by a mean (0 for exact)
     long blockers = 0;          ///< blocker pieces found inside shafts
     long events = 0;            ///< critical directions integrated over
-    long separated = 0;         ///< shafts closed by one blocker (answer 0 at once)
+    long separated = 0;         ///< shafts or sub-shafts closed by one blocker (answer 0 at once)
+    long subshafts = 0;         ///< shafts split in two because they held many blockers
 
     VisibilityStats& operator+=(const VisibilityStats& o) {
         queries += o.queries;
@@ -22,6 +23,7 @@ struct VisibilityStats {
         blockers += o.blockers;
         events += o.events;
         separated += o.separated;
+        subshafts += o.subshafts;
         return *this;
     }
 };
