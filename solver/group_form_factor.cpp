@@ -12,7 +12,7 @@
 namespace flatrad {
 
 GroupFormFactor group_form_factor(const Scene& scene, const std::vector<int>& from, const std::vector<int>& to,
-                                  FormFactorMethod method) {
+                                  FormFactorMethod method, const GroupFormFactorOptions& options) {
     const auto t0 = std::chrono::steady_clock::now();
     auto patches_of = [&](const std::vector<int>& surfaces) {
         std::vector<int> out;
@@ -31,9 +31,11 @@ GroupFormFactor group_form_factor(const Scene& scene, const std::vector<int>& fr
 
     const Hierarchy hierarchy(scene.segment_geometry());
     const ExactVisibility visibility(hierarchy);
+    const ClusterTables tables(hierarchy);
+    const MultiscaleVisibility multiscale(hierarchy, tables);
     // X_ij = L_i F_ij is symmetric, so one sum gives both directions:
     // F_AB = sum X / L_A, F_BA = sum X / L_B.
-    std::vector<double> row(A.size(), 0.0);
+    std::vector<double> row(A.size(), 0.0), row_bound(A.size(), 0.0);
     VisibilityStats stats;
 #pragma omp parallel
     {
@@ -43,27 +45,38 @@ GroupFormFactor group_form_factor(const Scene& scene, const std::vector<int>& fr
         for (size_t a = 0; a < A.size(); ++a) {
             const Patch& pa = scene.patches[static_cast<size_t>(A[a])];
             const Segment sa = scene.patch_segment(A[a]);
-            CompensatedSum sum;
+            CompensatedSum sum, bound;
             for (int q : B) {
                 const Patch& pb = scene.patches[static_cast<size_t>(q)];
                 if (pa.segment == pb.segment) continue;  // one line: no exchange
                 const Segment sb = scene.patch_segment(q);
                 if (method == FormFactorMethod::Unoccluded) {
                     sum.add(form_factor_unoccluded(sa, sb) * pa.length);
+                } else if (method == FormFactorMethod::Multiscale) {
+                    const MultiscaleResult r =
+                        multiscale.form_factor(sa, sb, pa.segment, pb.segment, options.eps, options.rule, ws, local);
+                    sum.add(r.F * pa.length);
+                    bound.add(r.error_bound * pa.length);
                 } else {
                     sum.add(visibility.exchange(sa, sb, pa.segment, pb.segment, ws, local));
                 }
             }
             row[a] = sum.value();
+            row_bound[a] = bound.value();
         }
 #pragma omp critical
         stats += local;
     }
-    CompensatedSum X;
+    CompensatedSum X, XB;
     for (double r : row) X.add(r);
+    for (double r : row_bound) XB.add(r);
     GroupFormFactor out;
     out.F = L_A.value() > 0 ? X.value() / L_A.value() : 0.0;
     out.F_reverse = L_B.value() > 0 ? X.value() / L_B.value() : 0.0;
+    out.error_bound = L_A.value() > 0 ? XB.value() / L_A.value() : 0.0;
+    out.error_bound_reverse = L_B.value() > 0 ? XB.value() / L_B.value() : 0.0;
+    out.table_seconds = tables.build_seconds();
+    out.tables_built = tables.built();
     out.stats = stats;
     out.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return out;

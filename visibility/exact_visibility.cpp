@@ -6,103 +6,12 @@
 
 #include "engine/error.h"
 #include "engine/formfactor.h"
+#include "visibility/shaft.h"
 
 namespace flatrad {
 
 namespace {
-
-// A blocker piece closer than this to the line of a patch, relative to the
-// shaft's size, lies along the patch (overlapping or touching segments): it
-// cannot stop a line that crosses the shaft's interior, so it is dropped.
-// Clipping rounds endpoints by a few ulps of the shaft size; 1e-13 is a
-// hundred times that and still far below any real gap.
-constexpr double on_edge_tolerance = 1e-13;
-
-// Slack, relative to the overlap width, when deciding whether a critical
-// direction happens inside the overlap of the two patches' projections.
-// Keeping an event that did not need to be kept costs time, never accuracy,
-// so this errs wide.
-constexpr double event_slack = 1e-9;
-
-// The shaft: the convex hull of the clipped pair, A0 A1 C0 C1 counter-clockwise
-// (i = A0 -> A1 and j = C0 -> C1 both lit on the left and facing each other).
-struct Shaft {
-    std::array<Vec2, 4> v;        // A0, A1, C0, C1
-    std::array<bool, 4> edge_ok;  // false for a zero-length side (shared endpoint)
-    Box box;
-
-    Shaft(const Segment& i, const Segment& j) : v{i.a, i.b, j.a, j.b} {
-        for (int e = 0; e < 4; ++e) {
-            edge_ok[static_cast<size_t>(e)] = !(v[static_cast<size_t>(e)] == v[static_cast<size_t>((e + 1) % 4)]);
-            box.add(v[static_cast<size_t>(e)]);
-        }
-    }
-
-    // Separating-axis test: the box's axes (bounding boxes overlap) and the
-    // shaft's edge normals (all four corners outside one edge).
-    bool overlaps(const Box& b) const {
-        if (b.hi.x < box.lo.x || b.lo.x > box.hi.x || b.hi.y < box.lo.y || b.lo.y > box.hi.y) return false;
-        const std::array<Vec2, 4> corner{b.lo, Vec2{b.hi.x, b.lo.y}, b.hi, Vec2{b.lo.x, b.hi.y}};
-        for (size_t e = 0; e < 4; ++e) {
-            if (!edge_ok[e]) continue;
-            const Vec2 p = v[e], q = v[(e + 1) % 4];
-            bool all_out = true;
-            for (const Vec2& c : corner)
-                if (orient(p, q, c) >= 0) { all_out = false; break; }
-            if (all_out) return false;
-        }
-        return true;
-    }
-
-    // Clips s to the closed shaft (Cyrus-Beck). Returns false when nothing of
-    // positive length is left. `enter` and `leave` receive the edges that
-    // cut the piece's ends (-1 when an end is an original endpoint).
-    bool clip(const Segment& s, Segment& out, int& enter, int& leave) const {
-        double t0 = 0, t1 = 1;
-        enter = leave = -1;
-        for (size_t e = 0; e < 4; ++e) {
-            if (!edge_ok[e]) continue;
-            const Vec2 p = v[e], q = v[(e + 1) % 4];
-            const double fa = orient(p, q, s.a), fb = orient(p, q, s.b);
-            if (fa < 0 && fb < 0) return false;
-            if (fa >= 0 && fb >= 0) continue;
-            const double t = fa / (fa - fb);
-            if (fa < 0) {
-                if (t > t0) { t0 = t; enter = static_cast<int>(e); }
-            } else {
-                if (t < t1) { t1 = t; leave = static_cast<int>(e); }
-            }
-        }
-        if (!(t1 > t0)) return false;
-        out = {t0 > 0 ? lerp(s.a, s.b, t0) : s.a, t1 < 1 ? lerp(s.a, s.b, t1) : s.b};
-        return !(out.a == out.b);
-    }
-};
-
-// Adds s, clipped to the shaft, to the blockers. Returns true when the piece
-// alone closes the shaft: it runs from one side edge (A1 -> C0, edge 1) to
-// the other (C1 -> A0, edge 3), so every line from i to j crosses it.
-bool add_blocker(const Shaft& shaft, const Segment& s, double size, std::vector<Segment>& blockers) {
-    Segment piece;
-    int enter = -1, leave = -1;
-    if (!shaft.clip(s, piece, enter, leave)) return false;
-    // Drop pieces lying along patch i (edge 0) or patch j (edge 2); note
-    // whether either end touches a patch's line.
-    const double tol = on_edge_tolerance * size * size;
-    bool end_on_patch_line = false;
-    for (size_t e : {size_t{0}, size_t{2}}) {
-        const Vec2 p = shaft.v[e], q = shaft.v[e + 1];
-        const bool a_on = orient(p, q, piece.a) <= tol, b_on = orient(p, q, piece.b) <= tol;
-        if (a_on && b_on) return false;
-        end_on_patch_line = end_on_patch_line || a_on || b_on;
-    }
-    // From side to side closes the shaft; but when a side edge is collinear
-    // with a patch (a clipped corner), the edge labels of Cyrus-Beck cannot
-    // tell the side from the patch, so ends on a patch's line never count.
-    if (!end_on_patch_line && ((enter == 1 && leave == 3) || (enter == 3 && leave == 1))) return true;
-    blockers.push_back(piece);
-    return false;
-}
+using namespace shaft_detail;
 
 // Angle of w from the frame axis u, in (-pi, pi].
 double angle_from(Vec2 u, Vec2 w) { return std::atan2(cross(u, w), dot(u, w)); }

@@ -86,8 +86,8 @@ void add_solve(CLI::App& app, Commands& c) {
                                       "paper's epsilon for Gamma), >= 0. Ignored by --method exact.")
                           ->type_name("E");
     cmd->add_option("--subdivide", a.subdivide,
-                    "K >= 1: elements per patch for --method exact. The dense matrix needs "
-                    "(patches x K)^2 x 8 bytes; more than 8 GiB is refused.")
+                    "K >= 1: elements per patch for --method exact. Its three dense matrices need "
+                    "3 x (patches x K)^2 x 8 bytes; more than 8 GiB is refused up front.")
         ->type_name("K")
         ->capture_default_str();
     cmd->add_option("--svg", a.svg, "Draw the solution as an SVG picture (not available yet).")
@@ -119,14 +119,24 @@ void add_formfactor(CLI::App& app, Commands& c) {
         ->type_name("B");
     cmd->add_option("--method", a.method,
                     "exact: exact visibility (the default). unoccluded: crossed strings, "
-                    "ignoring every blocker. multiscale: not available yet.")
+                    "ignoring every blocker. multiscale: clusters of blockers replaced by their "
+                    "mean directional transmittance where the criterion allows (--eps, --gamma); "
+                    "adds clusters_approximated and error_bound.")
         ->type_name("METHOD")
         ->check(CLI::IsMember({"exact", "unoccluded", "multiscale"}))
         ->capture_default_str();
     c.formfactor_eps = cmd->add_option(
         "--eps", c.ff_eps_value,
-        "Tolerance of --method multiscale, >= 0. Ignored by exact and unoccluded (reported as 0).")
+        "Tolerance of --method multiscale: each cluster is approximated only when its criterion "
+        "(a bound on the error it adds to F, absolute) is below E; 0 approximates nothing and "
+        "gives the exact value. Default 1e-3. Ignored by exact and unoccluded (reported as 0).")
                               ->type_name("E");
+    cmd->add_option("--gamma", a.gamma,
+                    "Criterion of --method multiscale: bound (rigorous L1 line-space bound, the "
+                    "default), paper (Soler 1995's Gamma as written) or line-space (DESIGN's L2 variant).")
+        ->type_name("RULE")
+        ->check(CLI::IsMember({"bound", "paper", "line-space"}))
+        ->capture_default_str();
 }
 
 void add_not_yet(CLI::App& app, Commands& c) {

@@ -54,12 +54,10 @@ std::vector<int> surface_group(const Scene& scene, const std::string& names, con
 }
 
 int run_formfactor(const FormFactorArgs& args, std::ostream& out, std::ostream& /*err*/) {
-    if (args.method == "multiscale")
-        throw UsageError(
-            "--method multiscale: not available yet (the multi-scale visibility module has not "
-            "landed); use --method exact or --method unoccluded");
     FormFactorMethod method;
-    if (args.method == "exact")
+    if (args.method == "multiscale")
+        method = FormFactorMethod::Multiscale;
+    else if (args.method == "exact")
         method = FormFactorMethod::Exact;
     else if (args.method == "unoccluded")
         method = FormFactorMethod::Unoccluded;
@@ -71,17 +69,35 @@ int run_formfactor(const FormFactorArgs& args, std::ostream& out, std::ostream& 
     const Scene scene = load_scene(args.scene);
     const std::vector<int> from = surface_group(scene, args.from, "--from");
     const std::vector<int> to = surface_group(scene, args.to, "--to");
-    const GroupFormFactor result = group_form_factor(scene, from, to, method);
+    GroupFormFactorOptions options;
+    options.eps = method == FormFactorMethod::Multiscale ? args.eps.value_or(default_multiscale_eps) : 0.0;
+    if (args.gamma == "paper")
+        options.rule = GammaRule::Paper;
+    else if (args.gamma == "line-space")
+        options.rule = GammaRule::LineSpace;
+    else if (args.gamma == "bound")
+        options.rule = GammaRule::Bound;
+    else
+        throw UsageError(fmt::format("--gamma {}: expected bound, paper or line-space", args.gamma));
+    const GroupFormFactor result = group_form_factor(scene, from, to, method, options);
 
     nlohmann::ordered_json j;
     j["from"] = args.from;
     j["to"] = args.to;
     j["method"] = args.method;
-    j["eps"] = 0.0;  // exact and unoccluded approximate nothing, whatever --eps says
+    j["eps"] = options.eps;  // exact and unoccluded approximate nothing, whatever --eps says
     j["F"] = result.F;
     j["F_reverse"] = result.F_reverse;
     j["time_s"] = result.time_s;
     j["clusters_visited"] = result.stats.clusters_visited;
+    if (method == FormFactorMethod::Multiscale) {
+        j["clusters_approximated"] = result.stats.approximated;
+        j["error_bound"] = result.error_bound;
+        j["error_bound_reverse"] = result.error_bound_reverse;
+        j["gamma"] = gamma_rule_name(options.rule);
+        j["tables_built"] = result.tables_built;
+        j["table_time_s"] = result.table_seconds;
+    }
     j["stats"] = visibility_stats_json(result.stats);
     out << j.dump(-1, ' ', false, nlohmann::ordered_json::error_handler_t::replace) << '\n'
         << std::flush;

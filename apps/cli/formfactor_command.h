@@ -11,11 +11,15 @@
 
 namespace flatrad {
 
+/// Default tolerance of --method multiscale: an absolute error of 1e-3 on F.
+inline constexpr double default_multiscale_eps = 1e-3;
+
 struct FormFactorArgs {
     std::string scene;              ///< scene file
     std::string from, to;           ///< comma-separated surface names
     std::string method = "exact";   ///< "exact", "unoccluded" or "multiscale"
     std::optional<double> eps;      ///< multiscale tolerance
+    std::string gamma = "bound";    ///< multiscale criterion: bound, paper or line-space
 };
 
 /// Indices of the surfaces named in `names` ("a,b,c"), in the order given,

@@ -171,7 +171,6 @@ TEST_CASE("cli: methods and commands that have not landed say so") {
 
     for (const auto& args : std::vector<std::vector<std::string>>{
              {"solve", scene, "--svg", tmp.path("x.svg")},
-             {"formfactor", scene, "--from", "lamp", "--to", "plate", "--method", "multiscale"},
              {"compare", scene},
              {"compare", scene, "--eps", "0.01"},
              {"sweep"}}) {
@@ -358,6 +357,15 @@ TEST_CASE("cli: formfactor of two facing unit plates is sqrt 2 - 1") {
         CHECK(j.contains("clusters_visited"));
         CHECK(j["stats"].contains("queries"));
     }
+    // multiscale with nothing to block: exact value, nothing approximated, bound 0.
+    const Run m = run({"formfactor", scene, "--from", "lamp", "--to", "plate", "--method", "multiscale", "--eps", "0.01"});
+    REQUIRE(m.status == 0);
+    const json jm = json::parse(m.out);
+    CHECK(jm["eps"] == 0.01);
+    CHECK(jm["F"].get<double>() == doctest::Approx(sqrt2_minus_1).epsilon(analytic_tol).scale(0));
+    CHECK(jm["clusters_approximated"] == 0);
+    CHECK(jm["error_bound"] == 0.0);
+    CHECK(run({"formfactor", scene, "--from", "lamp", "--to", "plate", "--method", "multiscale", "--gamma", "nope"}).status == 2);
     // exact is the default; a group naming a surface twice counts it once.
     const Run d = run({"formfactor", scene, "--from", "lamp,lamp", "--to", "plate"});
     REQUIRE(d.status == 0);

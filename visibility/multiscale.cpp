@@ -1,0 +1,401 @@
+#include "visibility/multiscale.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "engine/error.h"
+#include "engine/formfactor.h"
+#include "visibility/shaft.h"
+
+namespace flatrad {
+
+using namespace shaft_detail;
+
+namespace {
+
+constexpr double infinity = std::numeric_limits<double>::infinity();
+// The direction integral is computed to this share of eps (error in F), so
+// that its own error stays well below the approximation it serves.
+constexpr double quadrature_share = 1e-3;
+// Depth cap of the adaptive Gauss-Kronrod bisection on one arc.
+constexpr int max_quadrature_depth = 40;
+
+// Gauss-Kronrod 7-15 nodes and weights on [-1, 1] (standard constants).
+constexpr double xgk[8] = {0.991455371120812639206854697526329, 0.949107912342758524526189684047851,
+                           0.864864423359769072789712788640926, 0.741531185599394439863864773280788,
+                           0.586087235467691130294144845693013, 0.405845151377397166906606412076961,
+                           0.207784955007898467600689403773245, 0.0};
+constexpr double wgk[8] = {0.022935322010529224963732008058970, 0.063092092629978553290700663189204,
+                           0.104790010322250183839876322541518, 0.140653259715525918745189590510238,
+                           0.169004726639267902826583426598550, 0.190350578064785409913256402421014,
+                           0.204432940075298892414161999234649, 0.209482141084727828012999174891714};
+constexpr double wg[4] = {0.129484966168869693270611432679082, 0.279705391489276667901467771423780,
+                          0.381830050505118944950369775488975, 0.417959183673469387755102040816327};
+
+// What a pair looks like from the criteria's point of view (DESIGN §2).
+struct PairGeometry {
+    bool visible = false;
+    Segment ci, cj;        // mutually clipped
+    double L_i = 0;        // unclipped length of i (F is per unit length of i)
+    Vec2 origin, u;        // frame: origin at ci's midpoint, u bisecting the directions
+    double theta_u = 0;    // absolute direction of u
+    double delta_theta = 0;  // half spread of directions of lines meeting both
+    double r_min = 0;      // distance between the clipped patches
+    double T = 0;          // |sin(alpha - theta12) sin(beta - theta12)|
+};
+
+double point_segment_distance(Vec2 p, const Segment& s) {
+    const Vec2 d = s.b - s.a;
+    const double l2 = norm_squared(d);
+    const double t = l2 > 0 ? std::clamp(dot(p - s.a, d) / l2, 0.0, 1.0) : 0.0;
+    return distance(p, lerp(s.a, s.b, t));
+}
+
+PairGeometry pair_geometry(const Segment& i, const Segment& j) {
+    PairGeometry g;
+    const auto clipped = clip_to_lit_halfplanes(i, j);
+    if (!clipped) return g;
+    g.visible = true;
+    g.ci = clipped->first;
+    g.cj = clipped->second;
+    g.L_i = i.length();
+    g.origin = g.ci.midpoint();
+    Vec2 u0 = g.cj.midpoint() - g.origin;
+    u0 = u0 / norm(u0);
+    double lo = infinity, hi = -infinity;
+    for (Vec2 A : {g.ci.a, g.ci.b})
+        for (Vec2 C : {g.cj.a, g.cj.b}) {
+            const Vec2 w = C - A;
+            if (w == Vec2{}) continue;
+            const double phi = std::atan2(cross(u0, w), dot(u0, w));
+            lo = std::min(lo, phi);
+            hi = std::max(hi, phi);
+        }
+    const double mid = 0.5 * (lo + hi);
+    g.u = {u0.x * std::cos(mid) - u0.y * std::sin(mid), u0.x * std::sin(mid) + u0.y * std::cos(mid)};
+    g.theta_u = std::atan2(g.u.y, g.u.x);
+    g.delta_theta = 0.5 * (hi - lo);
+    // Segments that face each other after clipping do not cross; their
+    // distance is the least endpoint-to-segment distance.
+    g.r_min = std::min({point_segment_distance(g.ci.a, g.cj), point_segment_distance(g.ci.b, g.cj),
+                        point_segment_distance(g.cj.a, g.ci), point_segment_distance(g.cj.b, g.ci)});
+    const double alpha = std::atan2(i.b.y - i.a.y, i.b.x - i.a.x);
+    const double beta = std::atan2(j.b.y - j.a.y, j.b.x - j.a.x);
+    g.T = std::abs(std::sin(alpha - g.theta_u) * std::sin(beta - g.theta_u));
+    return g;
+}
+
+ClusterCriteria criteria_for(const ClusterTables& tables, int node, const PairGeometry& g) {
+    ClusterCriteria c;
+    if (!g.visible) return {infinity, infinity, infinity};
+    const ClusterTables::Sample s = tables.at(node, g.theta_u);
+    const double R = s.R1 + s.R2f;
+    // Soler 1995 §2.2: Gamma = (2 dtheta sqrt(dp) / r_min) T (R1 + R2);
+    // beyond Delta_theta, R1 says nothing: +infinity.
+    const bool wide = g.delta_theta > ClusterTables::max_delta_theta;
+    c.paper = wide || g.r_min <= 0 ? infinity : 2 * g.delta_theta * std::sqrt(s.delta_p) / g.r_min * g.T * R;
+    c.line_space = wide ? infinity : g.delta_theta * std::sqrt(s.delta_p) * R / g.L_i;
+    c.bound = g.delta_theta *
+              tables.max_l1_over(node, g.theta_u - g.delta_theta, g.theta_u + g.delta_theta) / g.L_i;
+    return c;
+}
+
+// An approximated cluster during integration: its box corners in the frame.
+struct Approx {
+    int node;
+    Vec2 corner[4];
+};
+
+struct Integrand {
+    const PairGeometry& g;
+    const std::vector<Vec2>& pts;  // A0 A1 C0 C1, then exact blocker endpoints
+    const std::vector<Approx>& approx;
+    const ClusterTables& tables;
+    mutable std::vector<double> ev_p;
+    mutable std::vector<int> ev_kind;
+    mutable std::vector<int32_t> ev_order;
+
+    // Free measure at direction phi (frame angle): the integral over the
+    // overlap of [no exact blocker] x prod tau_bar of the crossed clusters.
+    double operator()(double phi) const {
+        const double nx = -std::sin(phi), ny = std::cos(phi);
+        double p[4];
+        for (size_t k = 0; k < 4; ++k) p[k] = nx * pts[k].x + ny * pts[k].y;
+        const double lo = std::max(std::min(p[0], p[1]), std::min(p[2], p[3]));
+        const double hi = std::min(std::max(p[0], p[1]), std::max(p[2], p[3]));
+        if (!(hi > lo)) return 0;
+        // Events: exact blockers as (p, exact_open / exact_close), clusters
+        // as (p, +-(index + 1)). Their order changes little from one
+        // direction to the next (the integrator moves in small steps), so
+        // the previous order is kept and repaired by insertion sort.
+        constexpr int exact_open = 1 << 30, exact_close = -(1 << 30);
+        const size_t n_exact = (pts.size() - 4) / 2, n_ev = 2 * (n_exact + approx.size());
+        if (ev_order.size() != n_ev) {
+            ev_order.resize(n_ev);
+            for (size_t k = 0; k < n_ev; ++k) ev_order[k] = static_cast<int32_t>(k);
+            ev_kind.resize(n_ev);
+            for (size_t q = 0; q < n_exact; ++q) {
+                ev_kind[2 * q] = exact_open;
+                ev_kind[2 * q + 1] = exact_close;
+            }
+            for (size_t c = 0; c < approx.size(); ++c) {
+                ev_kind[2 * (n_exact + c)] = static_cast<int>(c) + 1;
+                ev_kind[2 * (n_exact + c) + 1] = -(static_cast<int>(c) + 1);
+            }
+        }
+        ev_p.resize(n_ev);
+        for (size_t q = 0; q < n_exact; ++q) {
+            const Vec2 A = pts[4 + 2 * q], B = pts[5 + 2 * q];
+            const double a = nx * A.x + ny * A.y, b = nx * B.x + ny * B.y;
+            ev_p[2 * q] = std::clamp(std::min(a, b), lo, hi);
+            ev_p[2 * q + 1] = std::clamp(std::max(a, b), lo, hi);
+        }
+        for (size_t c = 0; c < approx.size(); ++c) {
+            double mn = infinity, mx = -infinity;
+            for (const Vec2& q : approx[c].corner) {
+                const double v = nx * q.x + ny * q.y;
+                mn = std::min(mn, v);
+                mx = std::max(mx, v);
+            }
+            ev_p[2 * (n_exact + c)] = std::clamp(mn, lo, hi);
+            ev_p[2 * (n_exact + c) + 1] = std::clamp(mx, lo, hi);
+        }
+        for (size_t k = 1; k < n_ev; ++k) {
+            const int32_t key = ev_order[k];
+            const double v = ev_p[static_cast<size_t>(key)];
+            size_t r = k;
+            while (r > 0 && ev_p[static_cast<size_t>(ev_order[r - 1])] > v) {
+                ev_order[r] = ev_order[r - 1];
+                --r;
+            }
+            ev_order[r] = key;
+        }
+        // Sweep: exact depth, and the product of the open clusters' tau_bar
+        // (kept as a count of zeros and a sum of logs).
+        const double theta = g.theta_u + phi;
+        std::vector<double>& weight = scratch_weight;
+        weight.resize(approx.size());
+        for (size_t c = 0; c < approx.size(); ++c) weight[c] = tables.at(approx[c].node, theta).tau_bar;
+        int depth = 0, zeros = 0;
+        double log_sum = 0, at = lo, total = 0;
+        for (size_t k = 0; k < n_ev; ++k) {
+            const double x = ev_p[static_cast<size_t>(ev_order[k])];
+            const int kind = ev_kind[static_cast<size_t>(ev_order[k])];
+            if (x > at && depth == 0 && zeros == 0) total += (x - at) * std::exp(log_sum);
+            at = std::max(at, x);
+            if (kind == exact_open) {
+                ++depth;
+            } else if (kind == exact_close) {
+                --depth;
+            } else {
+                const double w = weight[static_cast<size_t>(std::abs(kind) - 1)];
+                const int sign = kind > 0 ? 1 : -1;
+                if (w <= 0)
+                    zeros += sign;
+                else
+                    log_sum += sign * std::log(w);
+            }
+        }
+        if (hi > at && depth == 0 && zeros == 0) total += (hi - at) * std::exp(log_sum);
+        return total;
+    }
+    mutable std::vector<double> scratch_weight;
+};
+
+// Adaptive Gauss-Kronrod on [a, b] to absolute tolerance tol; adds the
+// error estimate to err.
+template <class F>
+double adaptive_gk(const F& f, double a, double b, double tol, int depth, double& err, long& evals) {
+    const double c = 0.5 * (a + b), h = 0.5 * (b - a);
+    double k15 = wgk[7] * f(c), g7 = wg[3] * f(c);
+    evals += 15;
+    for (int q = 0; q < 7; ++q) {
+        const double fx = f(c - h * xgk[q]) + f(c + h * xgk[q]);
+        k15 += wgk[q] * fx;
+        if (q % 2 == 1) g7 += wg[q / 2] * fx;
+    }
+    k15 *= h;
+    g7 *= h;
+    const double e = std::abs(k15 - g7);
+    if (e <= tol || depth >= max_quadrature_depth || h <= 1e-15 * (std::abs(a) + std::abs(b))) {
+        err += e;
+        return k15;
+    }
+    return adaptive_gk(f, a, c, tol / 2, depth + 1, err, evals) + adaptive_gk(f, c, b, tol / 2, depth + 1, err, evals);
+}
+
+}  // namespace
+
+const char* gamma_rule_name(GammaRule r) {
+    switch (r) {
+        case GammaRule::Bound: return "bound";
+        case GammaRule::Paper: return "paper";
+        case GammaRule::LineSpace: return "line-space";
+    }
+    return "?";
+}
+
+MultiscaleVisibility::MultiscaleVisibility(const Hierarchy& hierarchy, const ClusterTables& tables)
+    : m_hierarchy(&hierarchy), m_tables(&tables) {
+    m_position.assign(hierarchy.segments().size(), -1);
+    for (size_t k = 0; k < hierarchy.order().size(); ++k)
+        m_position[static_cast<size_t>(hierarchy.order()[k])] = static_cast<int32_t>(k);
+}
+
+ClusterCriteria MultiscaleVisibility::criteria(int node, const Segment& i, const Segment& j) const {
+    return criteria_for(*m_tables, node, pair_geometry(i, j));
+}
+
+MultiscaleResult MultiscaleVisibility::form_factor(const Segment& i, const Segment& j, int skip_i, int skip_j,
+                                                   double eps, GammaRule rule, ExactWorkspace& ws,
+                                                   VisibilityStats& stats) const {
+    MultiscaleResult out;
+    const PairGeometry g = pair_geometry(i, j);
+    if (!g.visible) {
+        ++stats.culled;
+        return out;
+    }
+    const Shaft shaft(g.ci, g.cj);
+    const double size = shaft.box.diagonal();
+
+    // 1. Walk the hierarchy through the shaft: exact leaves, approximated
+    //    clusters, opened clusters.
+    auto holds = [&](const ClusterNode& n, int s) {
+        if (s < 0) return false;
+        const int32_t pos = m_position[static_cast<size_t>(s)];
+        return pos >= n.first && pos < n.first + n.count;
+    };
+    std::vector<Segment>& exact = ws.blockers;
+    exact.clear();
+    std::vector<Approx> approx;
+    double bound = 0;
+    bool separated = false;
+    auto& stack = ws.stack;
+    stack.clear();
+    if (m_hierarchy->root() >= 0) stack.push_back(m_hierarchy->root());
+    while (!stack.empty() && !separated) {
+        const int k = stack.back();
+        stack.pop_back();
+        const ClusterNode& n = m_hierarchy->node(k);
+        ++out.clusters_visited;
+        if (!shaft.overlaps(n.box)) continue;
+        if (n.leaf()) {
+            for (int q = n.first; q < n.first + n.count && !separated; ++q) {
+                const int s = m_hierarchy->order()[static_cast<size_t>(q)];
+                if (s == skip_i || s == skip_j) continue;
+                separated = add_blocker(shaft, m_hierarchy->segments()[static_cast<size_t>(s)], size, exact);
+            }
+            continue;
+        }
+        if (eps > 0 && !holds(n, skip_i) && !holds(n, skip_j) && shaft.contains(n.box)) {
+            const double gamma = criteria_for(*m_tables, k, g).value(rule);
+            if (gamma < eps) {
+                approx.push_back({k, {}});
+                bound += gamma;
+                continue;
+            }
+        }
+        stack.push_back(n.child[1]);
+        stack.push_back(n.child[0]);
+    }
+    stats.clusters_visited += out.clusters_visited;
+    ++stats.queries;
+    if (separated) {
+        // One exact blocker closes the shaft: 0 whatever was approximated.
+        ++stats.separated;
+        return out;
+    }
+    out.exact_blockers = static_cast<long>(exact.size());
+    out.clusters_approximated = static_cast<long>(approx.size());
+    stats.approximated += out.clusters_approximated;
+    stats.blockers += out.exact_blockers;
+
+    // 2. Nothing approximated: the exact integral.
+    if (approx.empty()) {
+        const std::vector<Segment> pieces = exact;  // exchange_with_blockers reuses ws.blockers
+        out.F = ExactVisibility::exchange_with_blockers(g.ci, g.cj, pieces, ws, stats) / g.L_i;
+        return out;
+    }
+
+    // 3. Otherwise integrate over directions numerically, in the pair's frame.
+    std::vector<Vec2> pts;
+    auto local = [&](Vec2 P) {
+        const Vec2 d = P - g.origin;
+        return Vec2{dot(d, g.u), dot(d, rot90(g.u))};
+    };
+    for (Vec2 P : {g.ci.a, g.ci.b, g.cj.a, g.cj.b}) pts.push_back(local(P));
+    for (const Segment& b : exact) {
+        pts.push_back(local(b.a));
+        pts.push_back(local(b.b));
+    }
+    for (Approx& a : approx) {
+        const Box& b = m_hierarchy->node(a.node).box;
+        const Vec2 c[4] = {b.lo, {b.hi.x, b.lo.y}, b.hi, {b.lo.x, b.hi.y}};
+        for (int q = 0; q < 4; ++q) a.corner[q] = local(c[q]);
+    }
+    // Critical directions: range ends and lines through two points of the
+    // exact part, or a box corner and a patch endpoint, inside the range.
+    double s_lo = infinity, s_hi = -infinity;
+    for (size_t a = 0; a < 2; ++a)
+        for (size_t c = 2; c < 4; ++c) {
+            const Vec2 w = pts[c] - pts[a];
+            if (w == Vec2{}) continue;
+            s_lo = std::min(s_lo, w.y / w.x);
+            s_hi = std::max(s_hi, w.y / w.x);
+        }
+    if (!(s_hi > s_lo)) return out;
+    std::vector<double> slopes{s_lo, s_hi};
+    const size_t n_exact = exact.size();
+    // Only lines that meet both patches matter (elsewhere nothing in the
+    // overlap changes): the line through P of slope s must cross [lo, hi].
+    auto consider = [&](Vec2 P, Vec2 Q) {
+        const Vec2 w = Q - P;
+        if (w.x == 0) return;
+        const double s = w.y / w.x;
+        if (!(s > s_lo && s < s_hi)) return;
+        double p4[4];
+        for (size_t k = 0; k < 4; ++k) p4[k] = -s * pts[k].x + pts[k].y;
+        const double lo = std::max(std::min(p4[0], p4[1]), std::min(p4[2], p4[3]));
+        const double hi = std::min(std::max(p4[0], p4[1]), std::max(p4[2], p4[3]));
+        const double p = -s * P.x + P.y;
+        const double slack = event_slack * (std::abs(hi - lo) + std::abs(p));
+        if (p < lo - slack || p > hi + slack) return;
+        // Hidden strictly inside an exact blocker's shadow: the integrand is
+        // 0 around (p, s) before and after, whatever the clusters weigh.
+        for (size_t q = 0; q < n_exact; ++q) {
+            const double da = -s * pts[4 + 2 * q].x + pts[4 + 2 * q].y - p;
+            const double db = -s * pts[5 + 2 * q].x + pts[5 + 2 * q].y - p;
+            if (da * db < 0 && std::min(std::abs(da), std::abs(db)) > slack) return;
+        }
+        slopes.push_back(s);
+    };
+    for (size_t a = 0; a < pts.size(); ++a)
+        for (size_t b = std::max(a + 1, a < 2 ? size_t{2} : a + 1); b < pts.size(); ++b) consider(pts[a], pts[b]);
+    for (const Approx& a : approx)
+        for (const Vec2& c : a.corner)
+            for (size_t q = 0; q < 4; ++q) consider(pts[q], c);
+    std::sort(slopes.begin(), slopes.end());
+    slopes.erase(std::unique(slopes.begin(), slopes.end()), slopes.end());
+    stats.events += static_cast<long>(slopes.size());
+    out.arcs = static_cast<long>(slopes.size()) - 1;
+
+    const Integrand f{g, pts, approx, *m_tables, {}, {}, {}, {}};
+    const double phi_lo = std::atan(slopes.front()), phi_hi = std::atan(slopes.back());
+    // Tolerance on the integral (= 2 L_i F): quadrature_share of eps in F.
+    const double tol = quadrature_share * std::max(eps, 1e-15) * 2 * g.L_i;
+    double integral = 0, err = 0;
+    long evals = 0;
+    for (size_t k = 0; k + 1 < slopes.size(); ++k) {
+        const double a = std::atan(slopes[k]), b = std::atan(slopes[k + 1]);
+        if (!(b > a)) continue;
+        integral += adaptive_gk(f, a, b, tol * (b - a) / (phi_hi - phi_lo), 0, err, evals);
+    }
+    out.evaluations = evals;
+    out.F = std::max(0.0, integral / 2 / g.L_i);
+    out.quadrature_error = err / 2 / g.L_i;
+    out.error_bound = bound + out.quadrature_error;
+    return out;
+}
+
+}  // namespace flatrad

@@ -1,0 +1,86 @@
+#pragma once
+/// Multi-scale visibility (Soler 1995, "Caractérisation multi-échelles de la
+/// visibilité pour les calculs de radiosité", §2-3; DESIGN.md §2).
+///
+/// The occluded form factor between two segments is the line-space integral
+/// of DESIGN §1 with a hierarchical transmittance tau_H in place of the
+/// exact one: walking the cluster hierarchy through the pair's shaft,
+///   - a leaf's segments are exact blockers;
+///   - a cluster wholly inside the shaft whose criterion Gamma is below eps
+///     is replaced by its mean directional transmittance tau_bar(theta) over
+///     the lines that cross its box;
+///   - any other cluster is opened (its children visited). A cluster that
+///     is not wholly inside the shaft is never approximated.
+/// With nothing approximated the result is the exact form factor (same code
+/// path as ExactVisibility). Otherwise the integral over directions is done
+/// by adaptive Gauss-Kronrod between the critical directions of the exact
+/// part, to 1e-3 eps; its error estimate is added to the bound.
+///
+/// Errors of several approximated clusters add up (for factors in [0, 1],
+/// |prod a - prod b| <= sum |a - b|), so the claimed bound is the sum of the
+/// criteria used. Each cluster is tested against eps alone, as in the paper.
+#include "visibility/cluster_tables.h"
+#include "visibility/exact_visibility.h"
+
+namespace flatrad {
+
+/// Which criterion decides (and bounds) an approximation. All are errors
+/// in F_ij (absolute), for one cluster.
+enum class GammaRule {
+    /// Rigorous line-space bound with L1 norms: the error of tau_bar over
+    /// the pair's directions is at most
+    ///   1/(2 L_i) Integral ||tau_C - tau_bar||_L1 dtheta <= delta_theta max L1 / L_i,
+    /// L1 = 2 delta_p tau_bar (1 - tau_bar) exactly for opaque segments,
+    /// plus the table's interpolation error. The default.
+    Bound,
+    /// The paper's Gamma as written: (2 delta_theta sqrt(delta_p) / r_min) |T| (R1 + R2),
+    /// with the filtered R1, R2 at theta_12.
+    Paper,
+    /// DESIGN §2's line-space variant: delta_theta sqrt(delta_p) (R1 + R2) / L_i.
+    LineSpace,
+};
+
+const char* gamma_rule_name(GammaRule r);
+
+/// The three criteria of one cluster for one pair (for experiments).
+struct ClusterCriteria {
+    double paper = 0, line_space = 0, bound = 0;
+    double value(GammaRule r) const {
+        return r == GammaRule::Paper ? paper : r == GammaRule::LineSpace ? line_space : bound;
+    }
+};
+
+struct MultiscaleResult {
+    double F = 0;               ///< F_ij
+    double error_bound = 0;     ///< claimed bound on |F - F_exact|
+    double quadrature_error = 0;  ///< part of the bound from the direction integral
+    long clusters_visited = 0;
+    long clusters_approximated = 0;
+    long exact_blockers = 0;
+    long arcs = 0;         ///< intervals of directions integrated separately
+    long evaluations = 0;  ///< integrand evaluations (cost of the direction integral)
+};
+
+class MultiscaleVisibility {
+public:
+    /// `tables` is built over `hierarchy`; both outlive this object.
+    MultiscaleVisibility(const Hierarchy& hierarchy, const ClusterTables& tables);
+
+    /// F_ij between lit-left segments i and j with absolute tolerance eps on
+    /// F; every hierarchy segment other than skip_i and skip_j an occluder.
+    MultiscaleResult form_factor(const Segment& i, const Segment& j, int skip_i, int skip_j, double eps,
+                                 GammaRule rule, ExactWorkspace& ws, VisibilityStats& stats) const;
+
+    /// The criteria of `node` for the pair (i, j) (unclipped, lit-left).
+    /// Infinite when the pair cannot see each other.
+    ClusterCriteria criteria(int node, const Segment& i, const Segment& j) const;
+
+    const ClusterTables& tables() const { return *m_tables; }
+
+private:
+    const Hierarchy* m_hierarchy;
+    const ClusterTables* m_tables;
+    std::vector<int32_t> m_position;  // segment number -> index in hierarchy order
+};
+
+}  // namespace flatrad
