@@ -11,9 +11,28 @@
 
 namespace flatrad {
 
+FormFactorContext::FormFactorContext(const Scene& scene)
+    : m_scene(&scene),
+      m_hierarchy(scene.segment_geometry()),
+      m_exact(m_hierarchy),
+      m_tables(m_hierarchy),
+      m_multiscale(m_hierarchy, m_tables) {}
+
 GroupFormFactor group_form_factor(const Scene& scene, const std::vector<int>& from, const std::vector<int>& to,
                                   FormFactorMethod method, const GroupFormFactorOptions& options) {
     const auto t0 = std::chrono::steady_clock::now();
+    const FormFactorContext context(scene);
+    GroupFormFactor out = context.compute(from, to, method, options);
+    out.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return out;
+}
+
+GroupFormFactor FormFactorContext::compute(const std::vector<int>& from, const std::vector<int>& to,
+                                           FormFactorMethod method, const GroupFormFactorOptions& options) const {
+    const auto t0 = std::chrono::steady_clock::now();
+    const Scene& scene = *m_scene;
+    const double table_s0 = m_tables.build_seconds();
+    const long tables0 = m_tables.built();
     auto patches_of = [&](const std::vector<int>& surfaces) {
         std::vector<int> out;
         for (size_t p = 0; p < scene.patches.size(); ++p)
@@ -29,10 +48,8 @@ GroupFormFactor group_form_factor(const Scene& scene, const std::vector<int>& fr
     for (int p : A) L_A.add(scene.patches[static_cast<size_t>(p)].length);
     for (int p : B) L_B.add(scene.patches[static_cast<size_t>(p)].length);
 
-    const Hierarchy hierarchy(scene.segment_geometry());
-    const ExactVisibility visibility(hierarchy);
-    const ClusterTables tables(hierarchy);
-    const MultiscaleVisibility multiscale(hierarchy, tables);
+    const ExactVisibility& visibility = m_exact;
+    const MultiscaleVisibility& multiscale = m_multiscale;
     // X_ij = L_i F_ij is symmetric, so one sum gives both directions:
     // F_AB = sum X / L_A, F_BA = sum X / L_B.
     std::vector<double> row(A.size(), 0.0), row_bound(A.size(), 0.0);
@@ -75,8 +92,8 @@ GroupFormFactor group_form_factor(const Scene& scene, const std::vector<int>& fr
     out.F_reverse = L_B.value() > 0 ? X.value() / L_B.value() : 0.0;
     out.error_bound = L_A.value() > 0 ? XB.value() / L_A.value() : 0.0;
     out.error_bound_reverse = L_B.value() > 0 ? XB.value() / L_B.value() : 0.0;
-    out.table_seconds = tables.build_seconds();
-    out.tables_built = tables.built();
+    out.table_seconds = m_tables.build_seconds() - table_s0;
+    out.tables_built = m_tables.built() - tables0;
     out.stats = stats;
     out.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return out;

@@ -31,7 +31,33 @@ struct GroupFormFactor {
     VisibilityStats stats;
 };
 
-/// `from` and `to` are surface indices (a surface may appear in both).
+/// A scene's visibility structures (hierarchy, exact visibility, lazily
+/// built cluster tables) kept warm across many form-factor queries, as a
+/// sweep over eps needs: tables built by one query serve the next.
+class FormFactorContext {
+public:
+    explicit FormFactorContext(const Scene& scene);
+    FormFactorContext(const FormFactorContext&) = delete;
+    FormFactorContext& operator=(const FormFactorContext&) = delete;
+
+    /// `from` and `to` are surface indices (a surface may appear in both).
+    /// `time_s` excludes building this context but includes any cluster
+    /// table the query builds (reported in table_seconds as well).
+    GroupFormFactor compute(const std::vector<int>& from, const std::vector<int>& to, FormFactorMethod method,
+                            const GroupFormFactorOptions& options = {}) const;
+
+    const Scene& scene() const { return *m_scene; }
+    const ClusterTables& tables() const { return m_tables; }
+
+private:
+    const Scene* m_scene;
+    Hierarchy m_hierarchy;
+    ExactVisibility m_exact;
+    ClusterTables m_tables;
+    MultiscaleVisibility m_multiscale;
+};
+
+/// One-shot form: builds a context and computes.
 GroupFormFactor group_form_factor(const Scene& scene, const std::vector<int>& from,
                                   const std::vector<int>& to, FormFactorMethod method,
                                   const GroupFormFactorOptions& options = {});

@@ -185,6 +185,17 @@ ClusterTables::Sample ClusterTables::at(int node, double theta) const {
     return s;
 }
 
+double ClusterTables::tau_bar_at(const ClusterTable& t, double theta) {
+    const double step = pi / directions;
+    const double x = theta / step - 0.5;
+    const double fl = std::floor(x);
+    const double f = x - fl;
+    const long k0l = static_cast<long>(fl);
+    const size_t k0 = static_cast<size_t>(((k0l % directions) + directions) % directions);
+    const size_t k1 = (k0 + 1) % directions;
+    return (1 - f) * t.tau_bar[k0] + f * t.tau_bar[k1];
+}
+
 double ClusterTables::max_l1_over(int node, double theta0, double theta1) const {
     const ClusterTable& t = table(node);
     const double step = pi / directions;

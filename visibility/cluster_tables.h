@@ -46,7 +46,7 @@ public:
     static constexpr int directions = 256;  ///< samples of theta over [0, pi)
     static constexpr int bins = 16;         ///< level-of-detail cells across the box
     /// Delta_theta of DESIGN §2: the widest direction spread R1 covers.
-    static constexpr double max_delta_theta = 0.1;
+    static constexpr double max_delta_theta = 0.25;
 
     explicit ClusterTables(const Hierarchy& hierarchy);
 
@@ -60,6 +60,8 @@ public:
     /// Linear interpolation at absolute direction theta (radians, any value:
     /// lines are unoriented, period pi).
     Sample at(int node, double theta) const;
+    /// tau_bar alone at theta, from a table already obtained (hot loops).
+    static double tau_bar_at(const ClusterTable& t, double theta);
     /// Largest L1 + delta_p * interp_err over the samples in [theta0, theta1]
     /// (and the two samples bracketing it): the L1 deviation bound over a
     /// range of directions.

@@ -21,17 +21,14 @@ constexpr double quadrature_share = 1e-3;
 // Depth cap of the adaptive Gauss-Kronrod bisection on one arc.
 constexpr int max_quadrature_depth = 40;
 
-// Gauss-Kronrod 7-15 nodes and weights on [-1, 1] (standard constants).
-constexpr double xgk[8] = {0.991455371120812639206854697526329, 0.949107912342758524526189684047851,
-                           0.864864423359769072789712788640926, 0.741531185599394439863864773280788,
-                           0.586087235467691130294144845693013, 0.405845151377397166906606412076961,
-                           0.207784955007898467600689403773245, 0.0};
-constexpr double wgk[8] = {0.022935322010529224963732008058970, 0.063092092629978553290700663189204,
-                           0.104790010322250183839876322541518, 0.140653259715525918745189590510238,
-                           0.169004726639267902826583426598550, 0.190350578064785409913256402421014,
-                           0.204432940075298892414161999234649, 0.209482141084727828012999174891714};
-constexpr double wg[4] = {0.129484966168869693270611432679082, 0.279705391489276667901467771423780,
-                          0.381830050505118944950369775488975, 0.417959183673469387755102040816327};
+// Gauss-Kronrod 3-7 nodes and weights on [-1, 1] (standard constants):
+// arcs between critical directions are short and smooth, so the low order
+// pair is the cheaper way to the tolerance.
+constexpr double xgk[4] = {0.960491268708020283423507092629080, 0.774596669241483377035853079956480,
+                           0.434243749346802558002071502844628, 0.0};
+constexpr double wgk[4] = {0.104656226026467265193823857192073, 0.268488089868333440728569280666710,
+                           0.401397414775962222905051818618432, 0.450916538658474142345110087045571};
+constexpr double wg[2] = {0.555555555555555555555555555555556, 0.888888888888888888888888888888889};
 
 // What a pair looks like from the criteria's point of view (DESIGN §2).
 struct PairGeometry {
@@ -96,8 +93,14 @@ ClusterCriteria criteria_for(const ClusterTables& tables, int node, const PairGe
     const bool wide = g.delta_theta > ClusterTables::max_delta_theta;
     c.paper = wide || g.r_min <= 0 ? infinity : 2 * g.delta_theta * std::sqrt(s.delta_p) / g.r_min * g.T * R;
     c.line_space = wide ? infinity : g.delta_theta * std::sqrt(s.delta_p) * R / g.L_i;
+    // Error of tau_bar in the integral: Int (tau - tau_bar) w dp with w in
+    // [0, 1] (the overlap window times everything else's transmittance).
+    // Since Int (tau - tau_bar) dp = 0 over the box's lines, w may be
+    // replaced by w - 1/2, so |error| <= ||tau - tau_bar||_L1 / 2 per
+    // direction; over 2 delta_theta of directions, halved again for
+    // L_i F = 1/2 Integral: delta_theta max L1 / (2 L_i).
     c.bound = g.delta_theta *
-              tables.max_l1_over(node, g.theta_u - g.delta_theta, g.theta_u + g.delta_theta) / g.L_i;
+              tables.max_l1_over(node, g.theta_u - g.delta_theta, g.theta_u + g.delta_theta) / (2 * g.L_i);
     return c;
 }
 
@@ -105,13 +108,13 @@ ClusterCriteria criteria_for(const ClusterTables& tables, int node, const PairGe
 struct Approx {
     int node;
     Vec2 corner[4];
+    const ClusterTable* table = nullptr;
 };
 
 struct Integrand {
     const PairGeometry& g;
     const std::vector<Vec2>& pts;  // A0 A1 C0 C1, then exact blocker endpoints
     const std::vector<Approx>& approx;
-    const ClusterTables& tables;
     mutable std::vector<double> ev_p;
     mutable std::vector<int> ev_kind;
     mutable std::vector<int32_t> ev_order;
@@ -176,7 +179,7 @@ struct Integrand {
         const double theta = g.theta_u + phi;
         std::vector<double>& weight = scratch_weight;
         weight.resize(approx.size());
-        for (size_t c = 0; c < approx.size(); ++c) weight[c] = tables.at(approx[c].node, theta).tau_bar;
+        for (size_t c = 0; c < approx.size(); ++c) weight[c] = ClusterTables::tau_bar_at(*approx[c].table, theta);
         int depth = 0, zeros = 0;
         double log_sum = 0, at = lo, total = 0;
         for (size_t k = 0; k < n_ev; ++k) {
@@ -203,27 +206,169 @@ struct Integrand {
     mutable std::vector<double> scratch_weight;
 };
 
-// Adaptive Gauss-Kronrod on [a, b] to absolute tolerance tol; adds the
-// error estimate to err.
+// Adaptive Gauss-Kronrod (3-7) on [a, b] to absolute tolerance tol; adds
+// the error estimate |K7 - G3| of every accepted piece to err.
 template <class F>
 double adaptive_gk(const F& f, double a, double b, double tol, int depth, double& err, long& evals) {
     const double c = 0.5 * (a + b), h = 0.5 * (b - a);
-    double k15 = wgk[7] * f(c), g7 = wg[3] * f(c);
-    evals += 15;
-    for (int q = 0; q < 7; ++q) {
+    const double fc = f(c);
+    double k7 = wgk[3] * fc, g3 = wg[1] * fc;
+    evals += 7;
+    for (int q = 0; q < 3; ++q) {
         const double fx = f(c - h * xgk[q]) + f(c + h * xgk[q]);
-        k15 += wgk[q] * fx;
-        if (q % 2 == 1) g7 += wg[q / 2] * fx;
+        k7 += wgk[q] * fx;
+        if (q == 1) g3 += wg[0] * fx;
     }
-    k15 *= h;
-    g7 *= h;
-    const double e = std::abs(k15 - g7);
+    k7 *= h;
+    g3 *= h;
+    const double e = std::abs(k7 - g3);
     if (e <= tol || depth >= max_quadrature_depth || h <= 1e-15 * (std::abs(a) + std::abs(b))) {
         err += e;
-        return k15;
+        return k7;
     }
     return adaptive_gk(f, a, c, tol / 2, depth + 1, err, evals) + adaptive_gk(f, c, b, tol / 2, depth + 1, err, evals);
 }
+
+// Same splitting rule as the exact integral: shafts crowded with exact
+// blockers are halved, so that critical directions stay few.
+constexpr size_t mixed_split_threshold = 16;
+constexpr int mixed_max_depth = 12;
+
+// The direction integral of [no exact blocker] x prod tau_bar over a facing
+// pair's shaft: 2 L_i F, by adaptive Gauss-Kronrod between the critical
+// directions of the exact blockers; crowded shafts are split first.
+struct MixedIntegral {
+    const Hierarchy& hierarchy;
+    const std::vector<Approx>& approx_world;
+    ExactWorkspace& ws;
+    VisibilityStats& stats;
+    long arcs, evals;
+    double err;
+
+    double solve(const Segment& ci, const Segment& cj, const Segment* candidates, size_t count, double tol,
+                 int depth) {
+        const Shaft shaft(ci, cj);
+        const double size = shaft.box.diagonal();
+        if (ws.levels.size() <= static_cast<size_t>(depth)) ws.levels.resize(static_cast<size_t>(depth) + 1);
+        std::vector<Segment>& mine = ws.levels[static_cast<size_t>(depth)];
+        mine.clear();
+        for (size_t k = 0; k < count; ++k) {
+            Box bb;
+            bb.add(candidates[k]);
+            if (!shaft.overlaps(bb)) continue;
+            if (add_blocker(shaft, candidates[k], size, mine)) {
+                ++stats.separated;
+                return 0;
+            }
+        }
+        const bool no_progress = depth > 0 && static_cast<double>(mine.size()) > 0.8 * static_cast<double>(count);
+        if (mine.size() > mixed_split_threshold && depth < mixed_max_depth && !no_progress) {
+            ++stats.subshafts;
+            const std::vector<Segment> pieces = mine;  // deeper levels reuse ws.levels
+            if (ci.length() >= cj.length()) {
+                const Vec2 m = ci.midpoint();
+                return solve({ci.a, m}, cj, pieces.data(), pieces.size(), tol / 2, depth + 1) +
+                       solve({m, ci.b}, cj, pieces.data(), pieces.size(), tol / 2, depth + 1);
+            }
+            const Vec2 m = cj.midpoint();
+            return solve(ci, {cj.a, m}, pieces.data(), pieces.size(), tol / 2, depth + 1) +
+                   solve(ci, {m, cj.b}, pieces.data(), pieces.size(), tol / 2, depth + 1);
+        }
+        return integrate(ci, cj, mine, tol);
+    }
+
+    double integrate(const Segment& ci, const Segment& cj, const std::vector<Segment>& exact, double tol) {
+        // Frame: origin at ci's midpoint, axis bisecting the directions.
+        PairGeometry g;
+        g.visible = true;
+        g.ci = ci;
+        g.cj = cj;
+        g.origin = ci.midpoint();
+        Vec2 u0 = cj.midpoint() - g.origin;
+        u0 = u0 / norm(u0);
+        double lo_a = infinity, hi_a = -infinity;
+        for (Vec2 A : {ci.a, ci.b})
+            for (Vec2 C : {cj.a, cj.b}) {
+                const Vec2 w = C - A;
+                if (w == Vec2{}) continue;
+                const double phi = std::atan2(cross(u0, w), dot(u0, w));
+                lo_a = std::min(lo_a, phi);
+                hi_a = std::max(hi_a, phi);
+            }
+        const double mid = 0.5 * (lo_a + hi_a);
+        g.u = {u0.x * std::cos(mid) - u0.y * std::sin(mid), u0.x * std::sin(mid) + u0.y * std::cos(mid)};
+        g.theta_u = std::atan2(g.u.y, g.u.x);
+        auto local = [&](Vec2 P) {
+            const Vec2 d = P - g.origin;
+            return Vec2{dot(d, g.u), dot(d, rot90(g.u))};
+        };
+        std::vector<Vec2> pts;
+        for (Vec2 P : {ci.a, ci.b, cj.a, cj.b}) pts.push_back(local(P));
+        for (const Segment& b : exact) {
+            pts.push_back(local(b.a));
+            pts.push_back(local(b.b));
+        }
+        std::vector<Approx> approx = approx_world;
+        for (Approx& a : approx) {
+            const Box& b = hierarchy.node(a.node).box;
+            const Vec2 c[4] = {b.lo, {b.hi.x, b.lo.y}, b.hi, {b.lo.x, b.hi.y}};
+            for (int q = 0; q < 4; ++q) a.corner[q] = local(c[q]);
+        }
+        double s_lo = infinity, s_hi = -infinity;
+        for (size_t a = 0; a < 2; ++a)
+            for (size_t c = 2; c < 4; ++c) {
+                const Vec2 w = pts[c] - pts[a];
+                if (w == Vec2{}) continue;
+                s_lo = std::min(s_lo, w.y / w.x);
+                s_hi = std::max(s_hi, w.y / w.x);
+            }
+        if (!(s_hi > s_lo)) return 0;
+        std::vector<double> slopes{s_lo, s_hi};
+        const size_t n_exact = exact.size();
+        // Only lines that meet both patches matter (elsewhere nothing in the
+        // overlap changes): the line through P of slope s must cross [lo, hi].
+        auto consider = [&](Vec2 P, Vec2 Q) {
+            const Vec2 w = Q - P;
+            if (w.x == 0) return;
+            const double s = w.y / w.x;
+            if (!(s > s_lo && s < s_hi)) return;
+            double p4[4];
+            for (size_t k = 0; k < 4; ++k) p4[k] = -s * pts[k].x + pts[k].y;
+            const double lo = std::max(std::min(p4[0], p4[1]), std::min(p4[2], p4[3]));
+            const double hi = std::min(std::max(p4[0], p4[1]), std::max(p4[2], p4[3]));
+            const double p = -s * P.x + P.y;
+            const double slack = event_slack * (std::abs(hi - lo) + std::abs(p));
+            if (p < lo - slack || p > hi + slack) return;
+            // Hidden strictly inside an exact blocker's shadow: the integrand
+            // is 0 around (p, s) before and after, whatever the clusters weigh.
+            for (size_t q = 0; q < n_exact; ++q) {
+                const double da = -s * pts[4 + 2 * q].x + pts[4 + 2 * q].y - p;
+                const double db = -s * pts[5 + 2 * q].x + pts[5 + 2 * q].y - p;
+                if (da * db < 0 && std::min(std::abs(da), std::abs(db)) > slack) return;
+            }
+            slopes.push_back(s);
+        };
+        for (size_t a = 0; a < pts.size(); ++a)
+            for (size_t b = std::max(a + 1, a < 2 ? size_t{2} : a + 1); b < pts.size(); ++b) consider(pts[a], pts[b]);
+        // Box corners crossing the overlap's ends or other intervals only put
+        // kinks in a continuous integrand: the adaptive rule finds them,
+        // which is cheaper than splitting at every one.
+        std::sort(slopes.begin(), slopes.end());
+        slopes.erase(std::unique(slopes.begin(), slopes.end()), slopes.end());
+        stats.events += static_cast<long>(slopes.size());
+        arcs += static_cast<long>(slopes.size()) - 1;
+
+        const Integrand f{g, pts, approx, {}, {}, {}, {}};
+        const double phi_lo = std::atan(slopes.front()), phi_hi = std::atan(slopes.back());
+        double integral = 0;
+        for (size_t k = 0; k + 1 < slopes.size(); ++k) {
+            const double a = std::atan(slopes[k]), b = std::atan(slopes[k + 1]);
+            if (!(b > a)) continue;
+            integral += adaptive_gk(f, a, b, tol * (b - a) / (phi_hi - phi_lo), 0, err, evals);
+        }
+        return integral;
+    }
+};
 
 }  // namespace
 
@@ -318,82 +463,15 @@ MultiscaleResult MultiscaleVisibility::form_factor(const Segment& i, const Segme
         return out;
     }
 
-    // 3. Otherwise integrate over directions numerically, in the pair's frame.
-    std::vector<Vec2> pts;
-    auto local = [&](Vec2 P) {
-        const Vec2 d = P - g.origin;
-        return Vec2{dot(d, g.u), dot(d, rot90(g.u))};
-    };
-    for (Vec2 P : {g.ci.a, g.ci.b, g.cj.a, g.cj.b}) pts.push_back(local(P));
-    for (const Segment& b : exact) {
-        pts.push_back(local(b.a));
-        pts.push_back(local(b.b));
-    }
-    for (Approx& a : approx) {
-        const Box& b = m_hierarchy->node(a.node).box;
-        const Vec2 c[4] = {b.lo, {b.hi.x, b.lo.y}, b.hi, {b.lo.x, b.hi.y}};
-        for (int q = 0; q < 4; ++q) a.corner[q] = local(c[q]);
-    }
-    // Critical directions: range ends and lines through two points of the
-    // exact part, or a box corner and a patch endpoint, inside the range.
-    double s_lo = infinity, s_hi = -infinity;
-    for (size_t a = 0; a < 2; ++a)
-        for (size_t c = 2; c < 4; ++c) {
-            const Vec2 w = pts[c] - pts[a];
-            if (w == Vec2{}) continue;
-            s_lo = std::min(s_lo, w.y / w.x);
-            s_hi = std::max(s_hi, w.y / w.x);
-        }
-    if (!(s_hi > s_lo)) return out;
-    std::vector<double> slopes{s_lo, s_hi};
-    const size_t n_exact = exact.size();
-    // Only lines that meet both patches matter (elsewhere nothing in the
-    // overlap changes): the line through P of slope s must cross [lo, hi].
-    auto consider = [&](Vec2 P, Vec2 Q) {
-        const Vec2 w = Q - P;
-        if (w.x == 0) return;
-        const double s = w.y / w.x;
-        if (!(s > s_lo && s < s_hi)) return;
-        double p4[4];
-        for (size_t k = 0; k < 4; ++k) p4[k] = -s * pts[k].x + pts[k].y;
-        const double lo = std::max(std::min(p4[0], p4[1]), std::min(p4[2], p4[3]));
-        const double hi = std::min(std::max(p4[0], p4[1]), std::max(p4[2], p4[3]));
-        const double p = -s * P.x + P.y;
-        const double slack = event_slack * (std::abs(hi - lo) + std::abs(p));
-        if (p < lo - slack || p > hi + slack) return;
-        // Hidden strictly inside an exact blocker's shadow: the integrand is
-        // 0 around (p, s) before and after, whatever the clusters weigh.
-        for (size_t q = 0; q < n_exact; ++q) {
-            const double da = -s * pts[4 + 2 * q].x + pts[4 + 2 * q].y - p;
-            const double db = -s * pts[5 + 2 * q].x + pts[5 + 2 * q].y - p;
-            if (da * db < 0 && std::min(std::abs(da), std::abs(db)) > slack) return;
-        }
-        slopes.push_back(s);
-    };
-    for (size_t a = 0; a < pts.size(); ++a)
-        for (size_t b = std::max(a + 1, a < 2 ? size_t{2} : a + 1); b < pts.size(); ++b) consider(pts[a], pts[b]);
-    for (const Approx& a : approx)
-        for (const Vec2& c : a.corner)
-            for (size_t q = 0; q < 4; ++q) consider(pts[q], c);
-    std::sort(slopes.begin(), slopes.end());
-    slopes.erase(std::unique(slopes.begin(), slopes.end()), slopes.end());
-    stats.events += static_cast<long>(slopes.size());
-    out.arcs = static_cast<long>(slopes.size()) - 1;
-
-    const Integrand f{g, pts, approx, *m_tables, {}, {}, {}, {}};
-    const double phi_lo = std::atan(slopes.front()), phi_hi = std::atan(slopes.back());
-    // Tolerance on the integral (= 2 L_i F): quadrature_share of eps in F.
+    // 3. Otherwise integrate over directions numerically.
+    for (Approx& a : approx) a.table = &m_tables->table(a.node);
     const double tol = quadrature_share * std::max(eps, 1e-15) * 2 * g.L_i;
-    double integral = 0, err = 0;
-    long evals = 0;
-    for (size_t k = 0; k + 1 < slopes.size(); ++k) {
-        const double a = std::atan(slopes[k]), b = std::atan(slopes[k + 1]);
-        if (!(b > a)) continue;
-        integral += adaptive_gk(f, a, b, tol * (b - a) / (phi_hi - phi_lo), 0, err, evals);
-    }
-    out.evaluations = evals;
+    MixedIntegral mi{*m_hierarchy, approx, ws, stats, 0, 0, 0};
+    const double integral = mi.solve(g.ci, g.cj, exact.data(), exact.size(), tol, 0);
+    out.arcs = mi.arcs;
+    out.evaluations = mi.evals;
     out.F = std::max(0.0, integral / 2 / g.L_i);
-    out.quadrature_error = err / 2 / g.L_i;
+    out.quadrature_error = mi.err / 2 / g.L_i;
     out.error_bound = bound + out.quadrature_error;
     return out;
 }

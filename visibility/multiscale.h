@@ -28,8 +28,9 @@ namespace flatrad {
 /// in F_ij (absolute), for one cluster.
 enum class GammaRule {
     /// Rigorous line-space bound with L1 norms: the error of tau_bar over
-    /// the pair's directions is at most
-    ///   1/(2 L_i) Integral ||tau_C - tau_bar||_L1 dtheta <= delta_theta max L1 / L_i,
+    /// the pair's directions is at most (the weight w in [0, 1] shifted by
+    /// 1/2, as tau - tau_bar integrates to 0 over the box's lines)
+    ///   1/(4 L_i) Integral ||tau_C - tau_bar||_L1 dtheta <= delta_theta max L1 / (2 L_i),
     /// L1 = 2 delta_p tau_bar (1 - tau_bar) exactly for opaque segments,
     /// plus the table's interpolation error. The default.
     Bound,

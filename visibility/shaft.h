@@ -97,12 +97,17 @@ inline bool add_blocker(const Shaft& shaft, const Segment& s, double size, std::
     int enter = -1, leave = -1;
     if (!shaft.clip(s, piece, enter, leave)) return false;
     // Drop pieces lying along patch i (edge 0) or patch j (edge 2); note
-    // whether either end touches a patch's line.
-    const double tol = on_edge_tolerance * size * size;
+    // whether either end touches a patch's line. orient(p, q, x) is |q - p|
+    // times x's distance to the line, so the distance bound on_edge_tolerance
+    // x size becomes a bound on orient through the patch's own length (not
+    // the shaft's: a 1e-8 patch facing a 1e8 one would otherwise see a
+    // blocker 0.5 away as lying on its line).
+    const double tol = on_edge_tolerance * size;
     bool end_on_patch_line = false;
     for (size_t e : {size_t{0}, size_t{2}}) {
         const Vec2 p = shaft.v[e], q = shaft.v[e + 1];
-        const bool a_on = orient(p, q, piece.a) <= tol, b_on = orient(p, q, piece.b) <= tol;
+        const double orient_tol = tol * distance(p, q);
+        const bool a_on = orient(p, q, piece.a) <= orient_tol, b_on = orient(p, q, piece.b) <= orient_tol;
         if (a_on && b_on) return false;
         end_on_patch_line = end_on_patch_line || a_on || b_on;
     }
