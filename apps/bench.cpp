@@ -1,1 +1,753 @@
-int main() { return 0; }
+// flatrad_bench: run time and memory of the exact solver and of exact
+// visibility (README.md, "Benchmarks"). Prints plain-text tables on stdout,
+// each headed by the command line that produced it; progress goes to stderr.
+//
+//   flatrad_bench rooms  [--repeat R] [--sizes E,...] [--blockers M,...]
+//   flatrad_bench ffcost [--repeat R] [--counts M,...]
+//   flatrad_bench matrix [--repeat R] [--plate-length L] [--seed S] [--sweep-lengths]
+//   flatrad_bench all
+//
+// `rooms` runs the real CLI (`flatrad solve`, found beside this program) as a
+// child process, for wall time and peak memory; `ffcost` and `matrix` call
+// the library in-process. Scenes are generated here with fixed seeds, so
+// every run measures the same geometry.
+#include <spawn.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <omp.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <numbers>
+#include <optional>
+#include <random>
+#include <set>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "engine/formfactor.h"
+#include "engine/geometry.h"
+#include "engine/scene.h"
+#include "solver/exact_solver.h"
+#include "visibility/exact_visibility.h"
+
+extern char** environ;
+
+namespace {
+
+using flatrad::Box;
+using flatrad::Segment;
+using flatrad::Vec2;
+using Clock = std::chrono::steady_clock;
+using Json = nlohmann::ordered_json;
+
+double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+// Bad flags: printed as one `error:` line, exit status 2 (as the CLI does).
+class UsageError : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
+constexpr const char* usage_text =
+    "usage: flatrad_bench COMMAND [options]\n"
+    "  rooms  [--repeat R] [--sizes E,...] [--blockers M,...]\n"
+    "         solve generated rooms with `flatrad solve --method exact` (child process):\n"
+    "         wall time, form-factor and linear-solve time, peak RSS. Defaults: R 3,\n"
+    "         sizes 500,1000,2000,4000, blockers 0,50,500.\n"
+    "  ffcost [--repeat R] [--counts M,...]\n"
+    "         time of one exact occluded form factor against the number M of blockers\n"
+    "         in its shaft. Defaults: R 5, counts 1,2,5,10,20,50,100,200,500,1000.\n"
+    "  matrix [--repeat R] [--plate-length L] [--seed S] [--sweep-lengths]\n"
+    "         the exact form-factor matrix of a room of 160 wall segments and 840\n"
+    "         two-sided plates (1840 patches). Defaults: R 3, L 0.025, S 1;\n"
+    "         --sweep-lengths adds plate lengths 0.01 and 0.05.\n"
+    "  all    ffcost, matrix and rooms with their defaults (rooms: E >= 4000 run once).\n";
+
+// ---------------------------------------------------------------------------
+// Small helpers: statistics, argument parsing, the command line.
+
+double median(std::vector<double> v) {
+    if (v.empty()) return std::nan("");
+    std::sort(v.begin(), v.end());
+    const size_t n = v.size();
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+std::string shell_quote(const std::string& word) {
+    const bool plain = !word.empty() && std::all_of(word.begin(), word.end(), [](char c) {
+        return std::isalnum(static_cast<unsigned char>(c)) || std::strchr("-_./,=:+@%", c) != nullptr;
+    });
+    if (plain) return word;
+    std::string q = "'";
+    for (char c : word) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return q + "'";
+}
+
+std::string command_line(int argc, char** argv) {
+    std::string line;
+    for (int k = 0; k < argc; ++k) {
+        if (k) line += ' ';
+        line += shell_quote(argv[k]);
+    }
+    return line;
+}
+
+// `--name value`, `--name=value` and bare flags after the command word.
+struct Options {
+    std::map<std::string, std::string> values;
+    std::set<std::string> flags;
+
+    std::optional<std::string> get(const std::string& name) const {
+        const auto it = values.find(name);
+        return it == values.end() ? std::nullopt : std::optional<std::string>(it->second);
+    }
+};
+
+Options parse_options(int argc, char** argv, const std::set<std::string>& valued, const std::set<std::string>& bare) {
+    Options o;
+    for (int k = 2; k < argc; ++k) {
+        std::string word = argv[k];
+        std::optional<std::string> inline_value;
+        if (const size_t eq = word.find('='); word.rfind("--", 0) == 0 && eq != std::string::npos) {
+            inline_value = word.substr(eq + 1);
+            word = word.substr(0, eq);
+        }
+        if (valued.count(word)) {
+            if (inline_value) {
+                o.values[word] = *inline_value;
+            } else {
+                if (k + 1 >= argc) throw UsageError(fmt::format("{}: expected a value", word));
+                o.values[word] = argv[++k];
+            }
+        } else if (bare.count(word) && !inline_value) {
+            o.flags.insert(word);
+        } else {
+            throw UsageError(fmt::format("{}: unknown option for `{}` (see flatrad_bench --help)", argv[k], argv[1]));
+        }
+    }
+    return o;
+}
+
+long parse_long(const std::string& text, const std::string& flag, long min_value) {
+    size_t used = 0;
+    long v = 0;
+    try {
+        v = std::stol(text, &used);
+    } catch (const std::exception&) {
+        used = 0;
+    }
+    if (used != text.size() || text.empty() || v < min_value)
+        throw UsageError(fmt::format("{}: expected an integer >= {}, got '{}'", flag, min_value, text));
+    return v;
+}
+
+double parse_positive(const std::string& text, const std::string& flag) {
+    size_t used = 0;
+    double v = 0;
+    try {
+        v = std::stod(text, &used);
+    } catch (const std::exception&) {
+        used = 0;
+    }
+    if (used != text.size() || text.empty() || !(std::isfinite(v) && v > 0))
+        throw UsageError(fmt::format("{}: expected a number > 0, got '{}'", flag, text));
+    return v;
+}
+
+std::vector<long> parse_list(const std::string& text, const std::string& flag, long min_value) {
+    std::vector<long> out;
+    size_t start = 0;
+    while (start <= text.size()) {
+        const size_t comma = std::min(text.find(',', start), text.size());
+        out.push_back(parse_long(text.substr(start, comma - start), flag, min_value));
+        start = comma + 1;
+    }
+    return out;
+}
+
+// ---------------------------------------------------------------------------
+// Scene generation: random non-crossing plates.
+
+// Whether closed segments p and q share a point (crossing or touching).
+bool segments_meet(const Segment& p, const Segment& q) {
+    using flatrad::orient;
+    const double d1 = orient(q.a, q.b, p.a), d2 = orient(q.a, q.b, p.b);
+    const double d3 = orient(p.a, p.b, q.a), d4 = orient(p.a, p.b, q.b);
+    auto opposite = [](double x, double y) { return (x > 0 && y < 0) || (x < 0 && y > 0); };
+    if (opposite(d1, d2) && opposite(d3, d4)) return true;
+    // Touching: an endpoint on the other segment (collinear within its box).
+    auto on = [](const Segment& s, Vec2 c, double d) {
+        return d == 0 && std::min(s.a.x, s.b.x) <= c.x && c.x <= std::max(s.a.x, s.b.x) &&
+               std::min(s.a.y, s.b.y) <= c.y && c.y <= std::max(s.a.y, s.b.y);
+    };
+    return on(q, p.a, d1) || on(q, p.b, d2) || on(p, q.a, d3) || on(p, q.b, d4);
+}
+
+bool inside(const Box& box, Vec2 p) { return p.x >= box.lo.x && p.x <= box.hi.x && p.y >= box.lo.y && p.y <= box.hi.y; }
+
+Box make_box(double x0, double y0, double x1, double y1) {
+    Box b;
+    b.add(Vec2{x0, y0});
+    b.add(Vec2{x1, y1});
+    return b;
+}
+
+// `count` segments of length `length`: centre uniform in `centres`,
+// direction uniform, both endpoints in `region`, none meeting a segment of
+// `fixed` or an earlier plate; a draw that fails is rejected and redrawn.
+// Sequential, so the first k plates of a larger draw with the same seed are
+// the plates of the smaller one.
+std::vector<Segment> random_plates(size_t count, double length, const Box& centres, const Box& region,
+                                   const std::vector<Segment>& fixed, std::mt19937_64& rng) {
+    std::uniform_real_distribution<double> ux(centres.lo.x, centres.hi.x), uy(centres.lo.y, centres.hi.y);
+    std::uniform_real_distribution<double> angle(0.0, std::numbers::pi);
+    std::vector<Segment> plates;
+    plates.reserve(count);
+    const long max_draws = 10000 + 1000 * static_cast<long>(count);
+    long draws = 0;
+    while (plates.size() < count) {
+        if (++draws > max_draws)
+            throw std::runtime_error(fmt::format("could not place {} non-crossing plates of length {} ({} draws)",
+                                                 count, length, max_draws));
+        const Vec2 c{ux(rng), uy(rng)};
+        const double t = angle(rng);
+        const Vec2 h = Vec2{std::cos(t), std::sin(t)} * (0.5 * length);
+        const Segment s{c - h, c + h};
+        if (!inside(region, s.a) || !inside(region, s.b)) continue;
+        auto meets = [&](const Segment& o) { return segments_meet(s, o); };
+        if (std::any_of(fixed.begin(), fixed.end(), meets) || std::any_of(plates.begin(), plates.end(), meets))
+            continue;
+        plates.push_back(s);
+    }
+    return plates;
+}
+
+Json point_json(Vec2 p) { return Json::array({p.x, p.y}); }
+
+// The points of an axis-aligned closed square [0, side]^2, `per_wall`
+// segments on each wall, counter-clockwise from the origin.
+Json square_points(double side, int per_wall) {
+    Json pts = Json::array();
+    for (int w = 0; w < 4; ++w)
+        for (int k = 0; k < per_wall; ++k) {
+            const double s = side * k / per_wall;
+            const Vec2 p = w == 0 ? Vec2{s, 0} : w == 1 ? Vec2{side, s} : w == 2 ? Vec2{side - s, side} : Vec2{0, side - s};
+            pts.push_back(point_json(p));
+        }
+    return pts;
+}
+
+Json plate_surface(const std::string& name, const std::string& material, const Segment& s, const char* side) {
+    return Json{{"name", name}, {"material", material}, {"points", Json::array({point_json(s.a), point_json(s.b)})},
+                {"side", side}};
+}
+
+// ---------------------------------------------------------------------------
+// rooms: the CLI on generated rooms, as a child process.
+
+constexpr double room_side = 10;
+constexpr double room_blocker_length = 0.3;
+constexpr uint64_t room_seed = 20240601;
+// Blocker endpoints stay this far inside the walls (so they never touch them).
+constexpr double room_margin = 0.01;
+// The lamp: 1 long, 0.5 below the ceiling, lit downward (right of a -> b).
+const Segment room_lamp{{4.5, 9.5}, {5.5, 9.5}};
+
+// W = max(40, E - M - 1) rounded to the nearest multiple of 4: a square has
+// four equal walls.
+int room_wall_segments(long E, long M) {
+    const long w = std::max(40L, E - M - 1);
+    return static_cast<int>(std::max(40L, (w + 2) / 4 * 4));
+}
+
+Json room_scene(long E, long M, int W) {
+    std::mt19937_64 rng(room_seed);
+    const auto blockers =
+        random_plates(static_cast<size_t>(M), room_blocker_length, make_box(0, 0, room_side, room_side),
+                      make_box(room_margin, room_margin, room_side - room_margin, room_side - room_margin),
+                      {room_lamp}, rng);
+    Json surfaces = Json::array();
+    surfaces.push_back(Json{{"name", "room"},
+                            {"material", "grey"},
+                            {"points", square_points(room_side, W / 4)},
+                            {"closed", true},
+                            {"side", "in"}});
+    surfaces.push_back(plate_surface("lamp", "lamp", room_lamp, "right"));
+    for (size_t k = 0; k < blockers.size(); ++k)
+        surfaces.push_back(plate_surface(fmt::format("blocker{}", k), "plate", blockers[k], "left"));
+    return Json{{"flatrad", 1},
+                {"name", fmt::format("bench room E={} M={} (W={})", E, M, W)},
+                {"materials",
+                 Json{{"grey", Json{{"reflectance", 0.5}}},
+                      {"lamp", Json{{"reflectance", 0.0}, {"emission", 1.0}}},
+                      {"plate", Json{{"reflectance", 0.3}}}}},
+                {"surfaces", std::move(surfaces)}};
+}
+
+struct ChildRun {
+    int status = -1;  // exit status, or 128 + signal
+    double wall_s = 0;
+    long max_rss_kib = 0;
+};
+
+// posix_spawn + wait4: wall time around the child's whole life and its peak
+// resident set (ru_maxrss, KiB on Linux).
+ChildRun run_child(const std::vector<std::string>& args) {
+    std::vector<char*> argv;
+    for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    ChildRun r;
+    pid_t pid = 0;
+    const auto t0 = Clock::now();
+    if (const int rc = posix_spawn(&pid, argv[0], nullptr, nullptr, argv.data(), environ); rc != 0)
+        throw std::runtime_error(fmt::format("cannot start {}: {}", args[0], std::strerror(rc)));
+    int status = 0;
+    struct rusage usage {};
+    while (wait4(pid, &status, 0, &usage) < 0)
+        if (errno != EINTR) throw std::runtime_error(fmt::format("wait4: {}", std::strerror(errno)));
+    r.wall_s = seconds_since(t0);
+    r.status = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    r.max_rss_kib = usage.ru_maxrss;
+    return r;
+}
+
+std::filesystem::path program_dir() {
+    std::error_code ec;
+    const auto self = std::filesystem::read_symlink("/proc/self/exe", ec);
+    if (ec) throw std::runtime_error("cannot find this program's directory (/proc/self/exe)");
+    return self.parent_path();
+}
+
+// A fresh temporary directory, removed with everything in it at the end.
+class TempDir {
+public:
+    TempDir() {
+        std::string tmpl = (std::filesystem::temp_directory_path() / "flatrad_bench.XXXXXX").string();
+        if (!mkdtemp(tmpl.data())) throw std::runtime_error(fmt::format("mkdtemp: {}", std::strerror(errno)));
+        m_path = tmpl;
+    }
+    ~TempDir() {
+        std::error_code ec;
+        std::filesystem::remove_all(m_path, ec);
+    }
+    TempDir(const TempDir&) = delete;
+    TempDir& operator=(const TempDir&) = delete;
+    const std::filesystem::path& path() const { return m_path; }
+
+private:
+    std::filesystem::path m_path;
+};
+
+struct RoomsOptions {
+    int repeat = 3;
+    std::vector<long> sizes{500, 1000, 2000, 4000};
+    std::vector<long> blockers{0, 50, 500};
+    long large_size = 0;  // when > 0, sizes >= large_size run once (for `all`)
+};
+
+struct RoomRow {
+    long E = 0, M = 0;
+    int W = 0, runs = 0;
+    long elements = 0, queries = 0;
+    int threads = 0;
+    double wall = 0, ff = 0, solve = 0, rest = 0, residual = 0, balance = 0, rss_mib = 0;
+    std::string failure;
+};
+
+void run_rooms(const RoomsOptions& o, const std::string& cmd) {
+    const std::filesystem::path source = program_dir() / "flatrad";
+    if (!std::filesystem::exists(source))
+        throw std::runtime_error(fmt::format("{} not found (build the flatrad target)", source.string()));
+    TempDir tmp;
+    // Run a private copy: a rebuild of the build tree during a long run
+    // would otherwise change the program between rows.
+    const std::filesystem::path flatrad = tmp.path() / "flatrad";
+    std::filesystem::copy_file(source, flatrad);
+
+    fmt::print("## rooms: `flatrad solve SCENE --method exact -o OUT --quiet` as a child process\n");
+    fmt::print("command: {}\n", cmd);
+    fmt::print("program: {} (copied at start, so that a rebuild cannot change it mid-run)\n", source.string());
+    fmt::print("scene: closed square room, side {}, W wall segments (grey, reflectance 0.5, lit in); a lamp\n"
+               "       [(4.5,9.5),(5.5,9.5)] (emission 1, reflectance 0, lit downward); M one-sided plates of\n"
+               "       length {} (reflectance 0.3), random, non-crossing, seed {}. W = max(40, E - M - 1)\n"
+               "       rounded to a multiple of 4; elements = W + M + 1 (--subdivide 1).\n",
+               room_side, room_blocker_length, room_seed);
+    fmt::print("times: median over runs; ff = stats.form_factor_time_s, lin = stats.linear_solve_time_s,\n"
+               "       rest = wall - ff - lin (process start, reading, writing); RSS = max ru_maxrss.\n");
+    if (o.large_size > 0)
+        fmt::print("note: sizes E >= {} run once (to keep `all` bounded), the others {} times.\n", o.large_size,
+                   o.repeat);
+    std::fflush(stdout);
+
+    std::vector<RoomRow> rows;
+    for (const long E : o.sizes)
+        for (const long M : o.blockers) {
+            RoomRow row;
+            row.E = E;
+            row.M = M;
+            row.W = room_wall_segments(E, M);
+            const int repeat = o.large_size > 0 && E >= o.large_size ? 1 : o.repeat;
+            const std::string stem = fmt::format("room_E{}_M{}", E, M);
+            const auto scene_path = tmp.path() / (stem + ".json");
+            const auto out_path = tmp.path() / (stem + ".result.json");
+            {
+                std::ofstream f(scene_path);
+                f << room_scene(E, M, row.W).dump() << '\n';
+                if (!f) throw std::runtime_error(fmt::format("cannot write {}", scene_path.string()));
+            }
+            std::vector<double> wall, ff, lin, rest;
+            long rss = 0;
+            for (int r = 0; r < repeat; ++r) {
+                fmt::print(stderr, "rooms: E={} M={} run {}/{} ...\n", E, M, r + 1, repeat);
+                std::filesystem::remove(out_path);
+                const ChildRun c = run_child({flatrad.string(), "solve", scene_path.string(), "--method", "exact",
+                                              "-o", out_path.string(), "--quiet"});
+                if (c.status != 0) {
+                    row.failure = fmt::format("flatrad exited with status {}", c.status);
+                    break;
+                }
+                std::ifstream in(out_path);
+                const nlohmann::json result = nlohmann::json::parse(in);
+                const auto& st = result.at("stats");
+                wall.push_back(c.wall_s);
+                ff.push_back(st.at("form_factor_time_s").get<double>());
+                lin.push_back(st.at("linear_solve_time_s").get<double>());
+                rest.push_back(c.wall_s - ff.back() - lin.back());
+                rss = std::max(rss, c.max_rss_kib);
+                row.elements = st.at("elements").get<long>();
+                row.queries = st.at("visibility").at("queries").get<long>();
+                row.threads = st.at("threads").get<int>();
+                row.residual = st.at("residual").get<double>();
+                double balance = 0;
+                for (const auto& b : result.at("totals").at("balance")) balance = std::max(balance, b.get<double>());
+                row.balance = balance;
+                ++row.runs;
+                fmt::print(stderr, "rooms: E={} M={} run {}/{}: wall {:.3f} s, ff {:.3f} s\n", E, M, r + 1, repeat,
+                           c.wall_s, ff.back());
+            }
+            row.wall = median(wall);
+            row.ff = median(ff);
+            row.solve = median(lin);
+            row.rest = median(rest);
+            row.rss_mib = static_cast<double>(rss) / 1024.0;
+            rows.push_back(row);
+        }
+
+    fmt::print("\n{:>5} {:>4} {:>5} {:>8} {:>4} {:>9} {:>9} {:>8} {:>7} {:>10} {:>9} {:>9} {:>8} {:>3}\n", "E", "M",
+               "W", "elements", "runs", "wall_s", "ff_s", "lin_s", "rest_s", "queries", "residual", "balance",
+               "RSS_MiB", "thr");
+    for (const RoomRow& r : rows) {
+        if (!r.failure.empty() && r.runs == 0) {
+            fmt::print("{:>5} {:>4} {:>5}  failed: {}\n", r.E, r.M, r.W, r.failure);
+            continue;
+        }
+        fmt::print("{:>5} {:>4} {:>5} {:>8} {:>4} {:>9.3f} {:>9.3f} {:>8.3f} {:>7.3f} {:>10} {:>9.2e} {:>9.2e} {:>8.1f} "
+                   "{:>3}{}\n",
+                   r.E, r.M, r.W, r.elements, r.runs, r.wall, r.ff, r.solve, r.rest, r.queries, r.residual, r.balance,
+                   r.rss_mib, r.threads, r.failure.empty() ? "" : "  (then failed: " + r.failure + ")");
+    }
+
+    // The goal.
+    const std::string goal = "1000-element room with 50 blockers solved exactly in under 10 s";
+    const auto it = std::find_if(rows.begin(), rows.end(), [](const RoomRow& r) { return r.E == 1000 && r.M == 50; });
+    if (it == rows.end() || it->runs == 0)
+        fmt::print("\ngoal: {}: not measured (needs 1000 in --sizes and 50 in --blockers)\n", goal);
+    else
+        fmt::print("\ngoal: {}: {} ({} elements, median wall {:.3f} s over {} run(s))\n", goal,
+                   it->wall < 10 ? "MET" : "NOT MET", it->elements, it->wall, it->runs);
+    std::fflush(stdout);
+}
+
+// ---------------------------------------------------------------------------
+// ffcost: one exact occluded form factor against the blockers in its shaft.
+
+// Sub-shaft splitting is newer than the other counters; show it when the
+// library has it.
+template <class S>
+long subshafts_of(const S& s) {
+    if constexpr (requires { s.subshafts; })
+        return s.subshafts;
+    else
+        return -1;
+}
+
+struct FfcostOptions {
+    int repeat = 5;
+    std::vector<long> counts{1, 2, 5, 10, 20, 50, 100, 200, 500, 1000};
+};
+
+// Each measurement runs the call this long at least, so that the clock's
+// resolution and the loop's overhead do not show.
+constexpr double ffcost_min_measure_s = 0.05;
+
+void run_ffcost(const FfcostOptions& o, const std::string& cmd) {
+    using flatrad::ExactVisibility;
+    const Segment i{{0, 0}, {1, 0}};  // lit up (left of a -> b)
+    const Segment j{{1, 1}, {0, 1}};  // lit down
+    const double F_unoccluded = flatrad::form_factor_unoccluded(i, j);
+
+    fmt::print("## ffcost: one exact occluded form factor, ExactVisibility::exchange_with_blockers (in-process)\n");
+    fmt::print("command: {}\n", cmd);
+    fmt::print("pair: i = [(0,0),(1,0)] lit up, j = [(1,1),(0,1)] lit down (unoccluded F = sqrt(2) - 1).\n"
+               "blockers: M segments fully inside the shaft, centre uniform in [0.05,0.95]x[0.1,0.9], random\n"
+               "          direction, length min(1.6/M, 0.4), non-crossing; seed = M.\n"
+               "time: median over {} measurements of the mean time per call, each measurement >= {} ms;\n"
+               "      counters are per call. exponent = log(t_M / t_prev) / log(M / M_prev).\n",
+               o.repeat, ffcost_min_measure_s * 1000);
+    std::fflush(stdout);
+
+    struct Row {
+        long M;
+        double length, us, F, blockers, events, separated, subshafts;
+        long calls;
+    };
+    std::vector<Row> rows;
+    flatrad::ExactWorkspace ws;
+    volatile double sink = 0;
+    for (const long M : o.counts) {
+        std::mt19937_64 rng(static_cast<uint64_t>(M));
+        const double length = std::min(1.6 / static_cast<double>(M), 0.4);
+        const auto blockers = random_plates(static_cast<size_t>(M), length, make_box(0.05, 0.1, 0.95, 0.9),
+                                            make_box(0, 0.01, 1, 0.99), {}, rng);
+        // One call for the value and the counters (the same on every call).
+        flatrad::VisibilityStats st;
+        const double X = ExactVisibility::exchange_with_blockers(i, j, blockers, ws, st);
+        // Calibrate: double the calls until they take 5 ms, then scale to the minimum.
+        long calls = 1;
+        double t = 0;
+        for (;;) {
+            const auto t0 = Clock::now();
+            flatrad::VisibilityStats scratch;
+            for (long c = 0; c < calls; ++c) sink = sink + ExactVisibility::exchange_with_blockers(i, j, blockers, ws, scratch);
+            t = seconds_since(t0);
+            if (t >= 0.005 || t >= ffcost_min_measure_s) break;
+            calls *= 2;
+        }
+        if (t < ffcost_min_measure_s)
+            calls = static_cast<long>(std::ceil(static_cast<double>(calls) * ffcost_min_measure_s / t * 1.1));
+        std::vector<double> per_call;
+        for (int r = 0; r < o.repeat; ++r) {
+            flatrad::VisibilityStats scratch;
+            const auto t0 = Clock::now();
+            for (long c = 0; c < calls; ++c) sink = sink + ExactVisibility::exchange_with_blockers(i, j, blockers, ws, scratch);
+            per_call.push_back(seconds_since(t0) / static_cast<double>(calls));
+        }
+        const Row row{M,
+                      length,
+                      median(per_call) * 1e6,
+                      X / i.length(),
+                      static_cast<double>(st.blockers),
+                      static_cast<double>(st.events),
+                      static_cast<double>(st.separated),
+                      static_cast<double>(subshafts_of(st)),
+                      calls};
+        rows.push_back(row);
+        fmt::print(stderr, "ffcost: M={} {:.3f} us/call ({} calls per measurement)\n", M, row.us, calls);
+    }
+
+    const bool show_sub = subshafts_of(flatrad::VisibilityStats{}) >= 0;
+    fmt::print("\n{:>5} {:>7} {:>12} {:>8} {:>9} {:>9} {:>9} {:>8} {:>5}{} {:>8}\n", "M", "length", "time_us",
+               "calls", "F", "F_unocc", "blockers", "events", "sep", show_sub ? fmt::format(" {:>9}", "subshafts") : "",
+               "exponent");
+    for (size_t k = 0; k < rows.size(); ++k) {
+        const Row& r = rows[k];
+        std::string exponent = "-";
+        if (k > 0 && r.M != rows[k - 1].M)
+            exponent = fmt::format("{:.2f}", std::log(r.us / rows[k - 1].us) /
+                                                 std::log(static_cast<double>(r.M) / static_cast<double>(rows[k - 1].M)));
+        fmt::print("{:>5} {:>7.4f} {:>12.3f} {:>8} {:>9.6f} {:>9.6f} {:>9.0f} {:>8.0f} {:>5.0f}{} {:>8}\n", r.M, r.length,
+                   r.us, r.calls, r.F, F_unoccluded, r.blockers, r.events, r.separated,
+                   show_sub ? fmt::format(" {:>9.0f}", r.subshafts) : "", exponent);
+    }
+    std::fflush(stdout);
+}
+
+// ---------------------------------------------------------------------------
+// matrix: the exact form-factor matrix of a cluttered room, in-process.
+
+struct MatrixOptions {
+    int repeat = 3;
+    double plate_length = 0.025;
+    uint64_t seed = 1;
+    bool sweep = false;
+};
+
+constexpr int matrix_per_wall = 40;
+constexpr size_t matrix_plates = 840;
+constexpr double matrix_margin = 0.01;
+constexpr double matrix_goal_s = 5;
+
+std::string matrix_scene_text(double plate_length, uint64_t seed) {
+    std::mt19937_64 rng(seed);
+    const Box region = make_box(matrix_margin, matrix_margin, 1 - matrix_margin, 1 - matrix_margin);
+    const auto plates = random_plates(matrix_plates, plate_length, region, region, {}, rng);
+    Json surfaces = Json::array();
+    surfaces.push_back(Json{{"name", "room"},
+                            {"material", "grey"},
+                            {"points", square_points(1, matrix_per_wall)},
+                            {"closed", true},
+                            {"side", "in"}});
+    for (size_t k = 0; k < plates.size(); ++k)
+        surfaces.push_back(plate_surface(fmt::format("plate{}", k), "plate", plates[k], "both"));
+    return Json{{"flatrad", 1},
+                {"name", fmt::format("bench matrix: 160 wall segments, 840 plates of length {}", plate_length)},
+                {"materials",
+                 Json{{"grey", Json{{"reflectance", 0.5}, {"emission", 1.0}}}, {"plate", Json{{"reflectance", 0.3}}}}},
+                {"surfaces", std::move(surfaces)}}
+        .dump();
+}
+
+void run_matrix(const MatrixOptions& o, const std::string& cmd) {
+    std::vector<double> lengths{o.plate_length};
+    if (o.sweep) {
+        lengths.push_back(0.01);
+        lengths.push_back(0.05);
+    }
+    std::sort(lengths.begin(), lengths.end());
+    lengths.erase(std::unique(lengths.begin(), lengths.end()), lengths.end());
+
+    fmt::print("## matrix: exact form-factor matrix, flatrad::solve_exact(scene, {{1, 0}}) (in-process)\n");
+    fmt::print("command: {}\n", cmd);
+    fmt::print("scene: closed unit square, 40 segments per wall (reflectance 0.5, emission 1, lit in) and 840\n"
+               "       two-sided plates (reflectance 0.3) of the given length, random, non-crossing, endpoints\n"
+               "       in [0.01,0.99]^2, seed {}: 1000 segments, 1840 patches, parsed by flatrad::parse_scene.\n"
+               "times: median over {} runs; ff = stats.form_factor_time_s, total = wall time of solve_exact.\n"
+               "threads: {} (OpenMP, all cores).\n",
+               o.seed, o.repeat, omp_get_max_threads());
+    std::fflush(stdout);
+
+    struct Row {
+        double length;
+        size_t segments, patches;
+        double ff, total, lin;
+        flatrad::SolveStats stats;
+        bool counters_stable;
+    };
+    std::vector<Row> rows;
+    for (const double L : lengths) {
+        const flatrad::Scene scene = flatrad::parse_scene(matrix_scene_text(L, o.seed), "bench-matrix");
+        Row row{L, scene.segments.size(), scene.patches.size(), 0, 0, 0, {}, true};
+        std::vector<double> ff, total, lin;
+        for (int r = 0; r < o.repeat; ++r) {
+            const auto t0 = Clock::now();
+            const flatrad::Solution sol = flatrad::solve_exact(scene, {1, 0});
+            total.push_back(seconds_since(t0));
+            ff.push_back(sol.stats.form_factor_time_s);
+            lin.push_back(sol.stats.linear_solve_time_s);
+            const auto& v = sol.stats.visibility;
+            if (r > 0) {
+                const auto& p = row.stats.visibility;
+                row.counters_stable = row.counters_stable && v.queries == p.queries && v.events == p.events &&
+                                      v.blockers == p.blockers && v.separated == p.separated;
+            }
+            row.stats = sol.stats;
+            fmt::print(stderr, "matrix: length {} run {}/{}: ff {:.3f} s, total {:.3f} s\n", L, r + 1, o.repeat,
+                       ff.back(), total.back());
+        }
+        row.ff = median(ff);
+        row.total = median(total);
+        row.lin = median(lin);
+        rows.push_back(row);
+    }
+
+    fmt::print("\n{:>7} {:>8} {:>7} {:>8} {:>8} {:>8} {:>8} {:>9} {:>8}\n", "length", "segments", "patches", "ff_s",
+               "lin_s", "total_s", "residual", "links", "goal<5s");
+    for (const Row& r : rows)
+        fmt::print("{:>7.3f} {:>8} {:>7} {:>8.3f} {:>8.3f} {:>8.3f} {:>8.1e} {:>9} {:>8}\n", r.length, r.segments,
+                   r.patches, r.ff, r.lin, r.total, r.stats.residual, r.stats.links,
+                   r.ff < matrix_goal_s ? "MET" : "NOT MET");
+    const bool show_sub = subshafts_of(flatrad::VisibilityStats{}) >= 0;
+    fmt::print("\nvisibility counters (stats.visibility{}):\n",
+               o.repeat > 1 ? fmt::format(" of the last run; marked where the {} runs differ", o.repeat) : "");
+    fmt::print("{:>7} {:>10} {:>10} {:>10} {:>10} {:>11} {:>12}{}\n", "length", "queries", "unoccluded", "culled",
+               "separated", "blockers", "events", show_sub ? fmt::format(" {:>10}", "subshafts") : "");
+    for (const Row& r : rows) {
+        const auto& v = r.stats.visibility;
+        fmt::print("{:>7.3f} {:>10} {:>10} {:>10} {:>10} {:>11} {:>12}{}{}\n", r.length, v.queries, v.unoccluded,
+                   v.culled, v.separated, v.blockers, v.events,
+                   show_sub ? fmt::format(" {:>10}", subshafts_of(v)) : "",
+                   r.counters_stable ? "" : "  (counters differed between runs)");
+    }
+    fmt::print("\ngoal: full exact form-factor matrix (1840 patches) in < {} s: ", matrix_goal_s);
+    for (size_t k = 0; k < rows.size(); ++k)
+        fmt::print("{}length {}: {} ({:.3f} s)", k ? "; " : "", rows[k].length,
+                   rows[k].ff < matrix_goal_s ? "MET" : "NOT MET", rows[k].ff);
+    fmt::print("\n");
+    std::fflush(stdout);
+}
+
+// ---------------------------------------------------------------------------
+
+int run(int argc, char** argv) {
+    if (argc < 2) throw UsageError("expected a command: rooms, ffcost, matrix or all (see --help)");
+    const std::string command = argv[1];
+    const std::string cmd = command_line(argc, argv);
+    if (command == "-h" || command == "--help") {
+        std::cout << usage_text;
+        return 0;
+    }
+    if (command == "rooms") {
+        const Options opt = parse_options(argc, argv, {"--repeat", "--sizes", "--blockers"}, {});
+        RoomsOptions o;
+        if (auto v = opt.get("--repeat")) o.repeat = static_cast<int>(parse_long(*v, "--repeat", 1));
+        if (auto v = opt.get("--sizes")) o.sizes = parse_list(*v, "--sizes", 1);
+        if (auto v = opt.get("--blockers")) o.blockers = parse_list(*v, "--blockers", 0);
+        run_rooms(o, cmd);
+    } else if (command == "ffcost") {
+        const Options opt = parse_options(argc, argv, {"--repeat", "--counts"}, {});
+        FfcostOptions o;
+        if (auto v = opt.get("--repeat")) o.repeat = static_cast<int>(parse_long(*v, "--repeat", 1));
+        if (auto v = opt.get("--counts")) o.counts = parse_list(*v, "--counts", 1);
+        run_ffcost(o, cmd);
+    } else if (command == "matrix") {
+        const Options opt = parse_options(argc, argv, {"--repeat", "--plate-length", "--seed"}, {"--sweep-lengths"});
+        MatrixOptions o;
+        if (auto v = opt.get("--repeat")) o.repeat = static_cast<int>(parse_long(*v, "--repeat", 1));
+        if (auto v = opt.get("--plate-length")) o.plate_length = parse_positive(*v, "--plate-length");
+        if (auto v = opt.get("--seed")) o.seed = static_cast<uint64_t>(parse_long(*v, "--seed", 0));
+        o.sweep = opt.flags.count("--sweep-lengths") > 0;
+        run_matrix(o, cmd);
+    } else if (command == "all") {
+        parse_options(argc, argv, {}, {});
+        run_ffcost({}, cmd + "  (= ffcost)");
+        fmt::print("\n");
+        run_matrix({}, cmd + "  (= matrix)");
+        fmt::print("\n");
+        RoomsOptions rooms;
+        rooms.large_size = 4000;
+        run_rooms(rooms, cmd + "  (= rooms, with E = 4000 run once)");
+    } else {
+        throw UsageError(fmt::format("{}: unknown command; expected rooms, ffcost, matrix or all", command));
+    }
+    return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    try {
+        return run(argc, argv);
+    } catch (const UsageError& e) {
+        std::cerr << "error: " << e.what() << '\n';
+        return 2;
+    } catch (const std::exception& e) {
+        std::cerr << "error: " << e.what() << '\n';
+        return 1;
+    }
+}

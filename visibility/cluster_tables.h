@@ -15,7 +15,8 @@
 ///         delta_p / bins, far below the cluster's size, are dropped);
 ///   R1  = sup over |theta' - theta| <= Delta_theta of || tau_f(., theta') - tau_f(., theta) ||_L2,
 ///         the filtered profiles compared in the box-centred frame (lines
-///         outside the box transmit 1).
+///         outside the box transmit 1); the sup is taken over offsets of
+///         1, 2, 4, ... samples and Delta_theta itself.
 ///
 /// How the tables are made, and why not as the paper does: the paper
 /// samples -log tau at the leaves and adds the children's densities

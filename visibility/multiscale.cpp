@@ -19,7 +19,7 @@ constexpr double infinity = std::numeric_limits<double>::infinity();
 // that its own error stays well below the approximation it serves.
 constexpr double quadrature_share = 1e-3;
 // Depth cap of the adaptive Gauss-Kronrod bisection on one arc.
-constexpr int max_quadrature_depth = 40;
+constexpr int max_quadrature_depth = 30;
 
 // Gauss-Kronrod 3-7 nodes and weights on [-1, 1] (standard constants):
 // arcs between critical directions are short and smooth, so the low order
@@ -222,7 +222,10 @@ double adaptive_gk(const F& f, double a, double b, double tol, int depth, double
     k7 *= h;
     g3 *= h;
     const double e = std::abs(k7 - g3);
-    if (e <= tol || depth >= max_quadrature_depth || h <= 1e-15 * (std::abs(a) + std::abs(b))) {
+    // Accept at the tolerance, at the depth cap, or when the difference is
+    // rounding noise (a tolerance below it can never be met by halving).
+    const double noise = 64 * std::numeric_limits<double>::epsilon() * (std::abs(k7) + h * std::abs(fc));
+    if (e <= tol || e <= noise || depth >= max_quadrature_depth || h <= 1e-15 * (std::abs(a) + std::abs(b))) {
         err += e;
         return k7;
     }
@@ -350,9 +353,30 @@ struct MixedIntegral {
         };
         for (size_t a = 0; a < pts.size(); ++a)
             for (size_t b = std::max(a + 1, a < 2 ? size_t{2} : a + 1); b < pts.size(); ++b) consider(pts[a], pts[b]);
-        // Box corners crossing the overlap's ends or other intervals only put
-        // kinks in a continuous integrand: the adaptive rule finds them,
-        // which is cheaper than splitting at every one.
+        // Box corners crossing the overlap's ends, exact blockers' ends or
+        // other boxes' corners, and the table's sample directions (tau_bar is
+        // linear between them), put kinks in the integrand. Splitting there
+        // keeps every arc smooth, so that the Gauss-Kronrod error estimate
+        // is trustworthy (across a kink it can miss the error by orders of
+        // magnitude, which the bound study caught).
+        for (size_t c = 0; c < approx.size(); ++c)
+            for (const Vec2& corner : approx[c].corner) {
+                for (size_t q = 0; q < pts.size(); ++q) consider(pts[q], corner);
+                for (size_t d = c; d < approx.size(); ++d)
+                    for (const Vec2& other : approx[d].corner)
+                        if (!(other == corner)) consider(corner, other);
+            }
+        {
+            constexpr double pi = 3.14159265358979323846;
+            const double step = pi / ClusterTables::directions;
+            const double phi_lo = std::atan(s_lo), phi_hi = std::atan(s_hi);
+            // Sample k sits at absolute (k + 1/2) step; in the frame, phi = theta - theta_u (mod pi).
+            const double first = std::ceil((g.theta_u + phi_lo) / step - 0.5);
+            for (double k = first; (k + 0.5) * step - g.theta_u < phi_hi; k += 1) {
+                const double phi = (k + 0.5) * step - g.theta_u;
+                if (phi > phi_lo && phi < phi_hi) slopes.push_back(std::tan(phi));
+            }
+        }
         std::sort(slopes.begin(), slopes.end());
         slopes.erase(std::unique(slopes.begin(), slopes.end()), slopes.end());
         stats.events += static_cast<long>(slopes.size());
@@ -395,6 +419,43 @@ ClusterCriteria MultiscaleVisibility::criteria(int node, const Segment& i, const
 MultiscaleResult MultiscaleVisibility::form_factor(const Segment& i, const Segment& j, int skip_i, int skip_j,
                                                    double eps, GammaRule rule, ExactWorkspace& ws,
                                                    VisibilityStats& stats) const {
+    auto range_of = [&](int s) {
+        return s < 0 ? SkipRange{} : SkipRange{m_position[static_cast<size_t>(s)], 1};
+    };
+    return form_factor_skipping(i, j, range_of(skip_i), range_of(skip_j), eps, rule, ws, stats);
+}
+
+TransmittanceResult MultiscaleVisibility::transmittance(int node_a, int node_b, double eps, GammaRule rule,
+                                                        ExactWorkspace& ws, VisibilityStats& stats) const {
+    // Cross-sections through the box centres, perpendicular to the line
+    // joining them, as wide as each box seen along it, facing each other.
+    const ClusterNode& A = m_hierarchy->node(node_a);
+    const ClusterNode& B = m_hierarchy->node(node_b);
+    const Vec2 ca = A.box.center(), cb = B.box.center();
+    TransmittanceResult out;
+    if (ca == cb) return out;
+    const Vec2 u = (cb - ca) / distance(ca, cb), v = rot90(u);
+    auto half_width = [&](const Box& b) {
+        const Vec2 e = b.extent();
+        return 0.5 * (std::abs(e.x * v.x) + std::abs(e.y * v.y));
+    };
+    const double ha = std::max(half_width(A.box), 1e-12 * distance(ca, cb));
+    const double hb = std::max(half_width(B.box), 1e-12 * distance(ca, cb));
+    const Segment sa{ca + v * ha, ca - v * ha}, sb{cb - v * hb, cb + v * hb};  // lit sides face each other
+    const double unoccluded = form_factor_unoccluded(sa, sb);
+    if (!(unoccluded > 0)) return out;
+    const MultiscaleResult r = form_factor_skipping(sa, sb, SkipRange{A.first, A.count}, SkipRange{B.first, B.count},
+                                                    eps * unoccluded, rule, ws, stats);
+    out.tau = std::min(1.0, r.F / unoccluded);
+    out.error_bound = r.error_bound / unoccluded;
+    out.clusters_visited = r.clusters_visited;
+    out.clusters_approximated = r.clusters_approximated;
+    return out;
+}
+
+MultiscaleResult MultiscaleVisibility::form_factor_skipping(const Segment& i, const Segment& j, SkipRange skip_a,
+                                                            SkipRange skip_b, double eps, GammaRule rule,
+                                                            ExactWorkspace& ws, VisibilityStats& stats) const {
     MultiscaleResult out;
     const PairGeometry g = pair_geometry(i, j);
     if (!g.visible) {
@@ -406,10 +467,13 @@ MultiscaleResult MultiscaleVisibility::form_factor(const Segment& i, const Segme
 
     // 1. Walk the hierarchy through the shaft: exact leaves, approximated
     //    clusters, opened clusters.
-    auto holds = [&](const ClusterNode& n, int s) {
-        if (s < 0) return false;
-        const int32_t pos = m_position[static_cast<size_t>(s)];
-        return pos >= n.first && pos < n.first + n.count;
+    // A node whose segments overlap a skipped range is never approximated.
+    auto holds = [&](const ClusterNode& n, SkipRange r) {
+        return r.count > 0 && r.first < n.first + n.count && n.first < r.first + r.count;
+    };
+    auto skipped = [&](int32_t pos) {
+        return (pos >= skip_a.first && pos < skip_a.first + skip_a.count) ||
+               (pos >= skip_b.first && pos < skip_b.first + skip_b.count);
     };
     std::vector<Segment>& exact = ws.blockers;
     exact.clear();
@@ -427,13 +491,13 @@ MultiscaleResult MultiscaleVisibility::form_factor(const Segment& i, const Segme
         if (!shaft.overlaps(n.box)) continue;
         if (n.leaf()) {
             for (int q = n.first; q < n.first + n.count && !separated; ++q) {
+                if (skipped(q)) continue;
                 const int s = m_hierarchy->order()[static_cast<size_t>(q)];
-                if (s == skip_i || s == skip_j) continue;
                 separated = add_blocker(shaft, m_hierarchy->segments()[static_cast<size_t>(s)], size, exact);
             }
             continue;
         }
-        if (eps > 0 && !holds(n, skip_i) && !holds(n, skip_j) && shaft.contains(n.box)) {
+        if (eps > 0 && !holds(n, skip_a) && !holds(n, skip_b) && shaft.contains(n.box)) {
             const double gamma = criteria_for(*m_tables, k, g).value(rule);
             if (gamma < eps) {
                 approx.push_back({k, {}});

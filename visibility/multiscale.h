@@ -62,6 +62,15 @@ struct MultiscaleResult {
     long evaluations = 0;  ///< integrand evaluations (cost of the direction integral)
 };
 
+/// Mean transmittance of the lines joining two clusters (for cluster-level
+/// links of the hierarchical solver).
+struct TransmittanceResult {
+    double tau = 0;          ///< in [0, 1]
+    double error_bound = 0;  ///< claimed bound on |tau - tau_exact|
+    long clusters_visited = 0;
+    long clusters_approximated = 0;
+};
+
 class MultiscaleVisibility {
 public:
     /// `tables` is built over `hierarchy`; both outlive this object.
@@ -72,6 +81,17 @@ public:
     MultiscaleResult form_factor(const Segment& i, const Segment& j, int skip_i, int skip_j, double eps,
                                  GammaRule rule, ExactWorkspace& ws, VisibilityStats& stats) const;
 
+    /// Transmittance between hierarchy nodes a and b with tolerance eps on
+    /// tau: the occluded over the unoccluded form factor between the two
+    /// boxes' cross-sections (segments through their centres, perpendicular
+    /// to the line joining them, as wide as each box seen along it, facing
+    /// each other), the segments inside a and b not counted as blockers.
+    /// The cross-sections stand in for the boxes: lines meeting both boxes
+    /// but missing a cross-section are not sampled (an approximation of the
+    /// link's geometry, not of visibility).
+    TransmittanceResult transmittance(int node_a, int node_b, double eps, GammaRule rule, ExactWorkspace& ws,
+                                      VisibilityStats& stats) const;
+
     /// The criteria of `node` for the pair (i, j) (unclipped, lit-left).
     /// Infinite when the pair cannot see each other.
     ClusterCriteria criteria(int node, const Segment& i, const Segment& j) const;
@@ -79,6 +99,14 @@ public:
     const ClusterTables& tables() const { return *m_tables; }
 
 private:
+    /// Positions [first, first + count) in the hierarchy's order.
+    struct SkipRange {
+        int32_t first = 0, count = 0;
+    };
+    MultiscaleResult form_factor_skipping(const Segment& i, const Segment& j, SkipRange skip_a, SkipRange skip_b,
+                                          double eps, GammaRule rule, ExactWorkspace& ws,
+                                          VisibilityStats& stats) const;
+
     const Hierarchy* m_hierarchy;
     const ClusterTables* m_tables;
     std::vector<int32_t> m_position;  // segment number -> index in hierarchy order

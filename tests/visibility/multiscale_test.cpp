@@ -105,3 +105,41 @@ TEST_CASE("multiscale: the reported error bound holds (rule: bound), and F -> ex
     CHECK(failures == 0);
     CHECK(approximated > checked / 4);  // the test exercises approximation
 }
+
+TEST_CASE("multiscale: transmittance between clusters is in [0, 1] and within its bound of eps = 0") {
+    std::mt19937_64 rng(5);
+    test::Cloud c = test::make_cloud(rng);
+    while (c.segments.size() < 100) c = test::make_cloud(rng);  // enough clusters to pair
+    const Hierarchy h(c.segments, 2);
+    const ClusterTables tables(h);
+    const MultiscaleVisibility ms(h, tables);
+    ExactWorkspace ws;
+    VisibilityStats st;
+    auto ancestor = [&](int a, int b) {  // a is an ancestor of b (or equal)
+        for (int x = b; x >= 0; x = h.node(x).parent)
+            if (x == a) return true;
+        return false;
+    };
+    int pairs = 0, partial = 0;
+    const int n = static_cast<int>(h.nodes().size());
+    for (int a = 1; a < n && pairs < 300; ++a)
+        for (int b = a + 1; b < n && pairs < 300; b += 3) {
+            if (ancestor(a, b) || ancestor(b, a)) continue;
+            ++pairs;
+            const TransmittanceResult t0 = ms.transmittance(a, b, 0.0, GammaRule::Bound, ws, st);
+            CHECK(t0.tau >= 0);
+            CHECK(t0.tau <= 1);
+            CHECK(t0.clusters_approximated == 0);
+            if (t0.tau > 0 && t0.tau < 1) ++partial;
+            const TransmittanceResult t1 = ms.transmittance(a, b, 0.05, GammaRule::Bound, ws, st);
+            CHECK(std::abs(t1.tau - t0.tau) <= t1.error_bound + 1e-12);
+        }
+    CHECK(pairs > 50);
+    CHECK(partial > 5);
+    MESSAGE(pairs << " cluster pairs, " << partial << " partly blocked");
+    // Two lone segments far from everything: nothing between, tau = 1.
+    const Hierarchy lone({Segment{{0, 0}, {0, 1}}, Segment{{5, 0}, {5, 1}}}, 1);
+    const ClusterTables lt(lone);
+    const MultiscaleVisibility lm(lone, lt);
+    CHECK(lm.transmittance(1, 2, 0.0, GammaRule::Bound, ws, st).tau == doctest::Approx(1.0).epsilon(1e-14));
+}
