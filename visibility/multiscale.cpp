@@ -175,17 +175,21 @@ struct Integrand {
             ev_order[r] = key;
         }
         // Sweep: exact depth, and the product of the open clusters' tau_bar
-        // (kept as a count of zeros and a sum of logs).
+        // (kept as a count of zeros and a running product: multiplied in
+        // on entry, divided out on exit; a handful of roundings per piece,
+        // far below the quadrature tolerance). tau_bar is linear in theta
+        // on an arc (arcs end at the table's samples): alpha + beta theta.
         const double theta = g.theta_u + phi;
         std::vector<double>& weight = scratch_weight;
         weight.resize(approx.size());
-        for (size_t c = 0; c < approx.size(); ++c) weight[c] = ClusterTables::tau_bar_at(*approx[c].table, theta);
+        for (size_t c = 0; c < approx.size(); ++c)
+            weight[c] = std::clamp(line_alpha[c] + line_beta[c] * theta, 0.0, 1.0);
         int depth = 0, zeros = 0;
-        double log_sum = 0, at = lo, total = 0;
+        double prod = 1, at = lo, total = 0;
         for (size_t k = 0; k < n_ev; ++k) {
             const double x = ev_p[static_cast<size_t>(ev_order[k])];
             const int kind = ev_kind[static_cast<size_t>(ev_order[k])];
-            if (x > at && depth == 0 && zeros == 0) total += (x - at) * std::exp(log_sum);
+            if (x > at && depth == 0 && zeros == 0) total += (x - at) * prod;
             at = std::max(at, x);
             if (kind == exact_open) {
                 ++depth;
@@ -193,15 +197,36 @@ struct Integrand {
                 --depth;
             } else {
                 const double w = weight[static_cast<size_t>(std::abs(kind) - 1)];
-                const int sign = kind > 0 ? 1 : -1;
                 if (w <= 0)
-                    zeros += sign;
+                    zeros += kind > 0 ? 1 : -1;
+                else if (kind > 0)
+                    prod *= w;
                 else
-                    log_sum += sign * std::log(w);
+                    prod /= w;
             }
         }
-        if (hi > at && depth == 0 && zeros == 0) total += (hi - at) * std::exp(log_sum);
+        if (hi > at && depth == 0 && zeros == 0) total += (hi - at) * prod;
         return total;
+    }
+    // tau_bar = alpha + beta theta of each cluster on the current arc.
+    mutable std::vector<double> line_alpha, line_beta;
+    void set_arc(double theta_mid) const {
+        line_alpha.resize(approx.size());
+        line_beta.resize(approx.size());
+        constexpr double pi = 3.14159265358979323846;
+        const double step = pi / ClusterTables::directions;
+        const double x = theta_mid / step - 0.5;
+        const double k0 = std::floor(x);
+        const long k0l = static_cast<long>(k0);
+        const size_t q0 = static_cast<size_t>(((k0l % ClusterTables::directions) + ClusterTables::directions) %
+                                              ClusterTables::directions);
+        const size_t q1 = (q0 + 1) % ClusterTables::directions;
+        const double theta0 = (k0 + 0.5) * step;
+        for (size_t c = 0; c < approx.size(); ++c) {
+            const double t0 = approx[c].table->tau_bar[q0], t1 = approx[c].table->tau_bar[q1];
+            line_beta[c] = (t1 - t0) / step;
+            line_alpha[c] = t0 - line_beta[c] * theta0;
+        }
     }
     mutable std::vector<double> scratch_weight;
 };
@@ -230,6 +255,30 @@ double adaptive_gk(const F& f, double a, double b, double tol, int depth, double
         return k7;
     }
     return adaptive_gk(f, a, c, tol / 2, depth + 1, err, evals) + adaptive_gk(f, c, b, tol / 2, depth + 1, err, evals);
+}
+
+// Simpson on [a, b] given f(a); returns f(b) in fb. Error estimate
+// |S - T| with T the trapezoid on the same points, halving until it is under
+// tol (or the depth cap); the estimates of accepted pieces add to err.
+template <class F>
+double adaptive_simpson(const F& f, double a, double b, double fa, double tol, int depth, double& err, long& evals,
+                        double& fb) {
+    const double m = 0.5 * (a + b);
+    const double fm = f(m);
+    fb = f(b);
+    evals += 2;
+    const double h = b - a;
+    const double S = h / 6 * (fa + 4 * fm + fb);
+    const double T = h / 4 * (fa + 2 * fm + fb);
+    const double e = std::abs(S - T);
+    const double noise = 64 * std::numeric_limits<double>::epsilon() * std::abs(S);
+    if (e <= tol || e <= noise || depth >= max_quadrature_depth) {
+        err += e;
+        return S;
+    }
+    double fmid = 0;
+    const double left = adaptive_simpson(f, a, m, fa, tol / 2, depth + 1, err, evals, fmid);
+    return left + adaptive_simpson(f, m, b, fm, tol / 2, depth + 1, err, evals, fb);
 }
 
 // Same splitting rule as the exact integral: shafts crowded with exact
@@ -382,13 +431,27 @@ struct MixedIntegral {
         stats.events += static_cast<long>(slopes.size());
         arcs += static_cast<long>(slopes.size()) - 1;
 
-        const Integrand f{g, pts, approx, {}, {}, {}, {}};
+        const Integrand f{g, pts, approx, {}, {}, {}, {}, {}, {}};
         const double phi_lo = std::atan(slopes.front()), phi_hi = std::atan(slopes.back());
+        // Arcs are short and smooth: Simpson's rule on each, its error
+        // bounded by |Simpson - trapezoid| (the trapezoid's error estimate,
+        // far above Simpson's own on a smooth arc: a safe estimate), halving
+        // an arc until that is under its share of the tolerance. The value at
+        // an arc's end is the next arc's start (the integrand is continuous),
+        // so an arc costs about two evaluations.
         double integral = 0;
+        double a = std::atan(slopes.front());
+        f.set_arc(g.theta_u + a);
+        double fa = f(a);
+        ++evals;
         for (size_t k = 0; k + 1 < slopes.size(); ++k) {
-            const double a = std::atan(slopes[k]), b = std::atan(slopes[k + 1]);
+            const double b = std::atan(slopes[k + 1]);
             if (!(b > a)) continue;
-            integral += adaptive_gk(f, a, b, tol * (b - a) / (phi_hi - phi_lo), 0, err, evals);
+            f.set_arc(g.theta_u + 0.5 * (a + b));
+            double fb = 0;
+            integral += adaptive_simpson(f, a, b, fa, tol * (b - a) / (phi_hi - phi_lo), 0, err, evals, fb);
+            a = b;
+            fa = fb;
         }
         return integral;
     }
