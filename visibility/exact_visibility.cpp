@@ -13,32 +13,13 @@ namespace flatrad {
 namespace {
 using namespace shaft_detail;
 
-// Angle of w from the frame axis u, in (-pi, pi].
-double angle_from(Vec2 u, Vec2 w) { return std::atan2(cross(u, w), dot(u, w)); }
-
 // The line-space integral over the shaft (DESIGN.md §1) with the given
 // blocker pieces, all inside the shaft. Returns L_i F_ij.
 double integrate(const Segment& ci, const Segment& cj, const std::vector<Segment>& blockers, ExactWorkspace& ws,
                  VisibilityStats& stats) {
-    // 1. Frame. Origin at i's midpoint; axis u bisecting the range of
-    //    directions of lines meeting both patches, so that the range is
-    //    [-h, h] with h < pi/2 and the slope s = tan(phi) is a monotone,
-    //    well-conditioned parameter for directions inside it.
-    const Vec2 origin = ci.midpoint();
-    Vec2 u0 = cj.midpoint() - origin;
-    u0 = u0 / norm(u0);
-    double phi_lo = std::numeric_limits<double>::infinity(), phi_hi = -phi_lo;
-    for (Vec2 A : {ci.a, ci.b})
-        for (Vec2 C : {cj.a, cj.b}) {
-            const Vec2 w = C - A;
-            if (w == Vec2{}) continue;
-            const double phi = angle_from(u0, w);
-            phi_lo = std::min(phi_lo, phi);
-            phi_hi = std::max(phi_hi, phi);
-        }
-    const double mid = 0.5 * (phi_lo + phi_hi);
-    const Vec2 u{u0.x * std::cos(mid) - u0.y * std::sin(mid), u0.x * std::sin(mid) + u0.y * std::cos(mid)};
-    const Vec2 v = rot90(u);
+    // 1. Frame (shaft.h): directions measured from the pair's own axis.
+    const PairFrame frame(ci, cj);
+    const Vec2 origin = frame.origin, u = frame.u, v = rot90(u);
 
     // 2. Points in the frame: A0 A1 C0 C1, then blocker endpoints.
     auto& pts = ws.points;
@@ -228,18 +209,10 @@ double solve_shaft(const Segment& ci, const Segment& cj, const Segment* candidat
                    ExactWorkspace& ws, VisibilityStats& stats) {
     // `count` is also the parent's number of pieces: a split that kept most
     // of them did not pay, so this level integrates instead of splitting on.
-    const Shaft shaft(ci, cj);
-    const double size = shaft.box.diagonal();
     auto& mine = ws.levels[static_cast<size_t>(depth)];
-    mine.clear();
-    for (size_t k = 0; k < count; ++k) {
-        Box bb;
-        bb.add(candidates[k]);
-        if (!shaft.overlaps(bb)) continue;
-        if (add_blocker(shaft, candidates[k], size, mine)) {
-            ++stats.separated;
-            return 0;
-        }
+    if (clip_candidates(Shaft(ci, cj), candidates, count, mine)) {
+        ++stats.separated;
+        return 0;
     }
     if (mine.empty()) return exchange_crossed_strings(ci, cj);
     const bool no_progress = depth > 0 && static_cast<double>(mine.size()) > split_keep_ratio * static_cast<double>(count);

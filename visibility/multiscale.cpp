@@ -57,22 +57,11 @@ PairGeometry pair_geometry(const Segment& i, const Segment& j) {
     g.ci = clipped->first;
     g.cj = clipped->second;
     g.L_i = i.length();
-    g.origin = g.ci.midpoint();
-    Vec2 u0 = g.cj.midpoint() - g.origin;
-    u0 = u0 / norm(u0);
-    double lo = infinity, hi = -infinity;
-    for (Vec2 A : {g.ci.a, g.ci.b})
-        for (Vec2 C : {g.cj.a, g.cj.b}) {
-            const Vec2 w = C - A;
-            if (w == Vec2{}) continue;
-            const double phi = std::atan2(cross(u0, w), dot(u0, w));
-            lo = std::min(lo, phi);
-            hi = std::max(hi, phi);
-        }
-    const double mid = 0.5 * (lo + hi);
-    g.u = {u0.x * std::cos(mid) - u0.y * std::sin(mid), u0.x * std::sin(mid) + u0.y * std::cos(mid)};
-    g.theta_u = std::atan2(g.u.y, g.u.x);
-    g.delta_theta = 0.5 * (hi - lo);
+    const PairFrame frame(g.ci, g.cj);
+    g.origin = frame.origin;
+    g.u = frame.u;
+    g.theta_u = frame.theta_u;
+    g.delta_theta = frame.delta_theta;
     // Segments that face each other after clipping do not cross; their
     // distance is the least endpoint-to-segment distance.
     g.r_min = std::min({point_segment_distance(g.ci.a, g.cj), point_segment_distance(g.ci.b, g.cj),
@@ -299,19 +288,11 @@ struct MixedIntegral {
 
     double solve(const Segment& ci, const Segment& cj, const Segment* candidates, size_t count, double tol,
                  int depth) {
-        const Shaft shaft(ci, cj);
-        const double size = shaft.box.diagonal();
         if (ws.levels.size() <= static_cast<size_t>(depth)) ws.levels.resize(static_cast<size_t>(depth) + 1);
         std::vector<Segment>& mine = ws.levels[static_cast<size_t>(depth)];
-        mine.clear();
-        for (size_t k = 0; k < count; ++k) {
-            Box bb;
-            bb.add(candidates[k]);
-            if (!shaft.overlaps(bb)) continue;
-            if (add_blocker(shaft, candidates[k], size, mine)) {
-                ++stats.separated;
-                return 0;
-            }
+        if (clip_candidates(Shaft(ci, cj), candidates, count, mine)) {
+            ++stats.separated;
+            return 0;
         }
         const bool no_progress = depth > 0 && static_cast<double>(mine.size()) > 0.8 * static_cast<double>(count);
         if (mine.size() > mixed_split_threshold && depth < mixed_max_depth && !no_progress) {
@@ -335,25 +316,11 @@ struct MixedIntegral {
         g.visible = true;
         g.ci = ci;
         g.cj = cj;
-        g.origin = ci.midpoint();
-        Vec2 u0 = cj.midpoint() - g.origin;
-        u0 = u0 / norm(u0);
-        double lo_a = infinity, hi_a = -infinity;
-        for (Vec2 A : {ci.a, ci.b})
-            for (Vec2 C : {cj.a, cj.b}) {
-                const Vec2 w = C - A;
-                if (w == Vec2{}) continue;
-                const double phi = std::atan2(cross(u0, w), dot(u0, w));
-                lo_a = std::min(lo_a, phi);
-                hi_a = std::max(hi_a, phi);
-            }
-        const double mid = 0.5 * (lo_a + hi_a);
-        g.u = {u0.x * std::cos(mid) - u0.y * std::sin(mid), u0.x * std::sin(mid) + u0.y * std::cos(mid)};
-        g.theta_u = std::atan2(g.u.y, g.u.x);
-        auto local = [&](Vec2 P) {
-            const Vec2 d = P - g.origin;
-            return Vec2{dot(d, g.u), dot(d, rot90(g.u))};
-        };
+        const PairFrame frame(ci, cj);
+        g.origin = frame.origin;
+        g.u = frame.u;
+        g.theta_u = frame.theta_u;
+        auto local = [&](Vec2 P) { return frame.local(P); };
         std::vector<Vec2> pts;
         for (Vec2 P : {ci.a, ci.b, cj.a, cj.b}) pts.push_back(local(P));
         for (const Segment& b : exact) {

@@ -3,6 +3,8 @@
 /// mutually clipped patches, and the clipping of blockers to it. Shared by
 /// the exact and the multi-scale visibility. Internal to visibility/.
 #include <array>
+#include <cmath>
+#include <limits>
 #include <vector>
 
 #include "engine/geometry.h"
@@ -116,6 +118,53 @@ inline bool add_blocker(const Shaft& shaft, const Segment& s, double size, std::
     // tell the side from the patch, so ends on a patch's line never count.
     if (!end_on_patch_line && ((enter == 1 && leave == 3) || (enter == 3 && leave == 1))) return true;
     blockers.push_back(piece);
+    return false;
+}
+
+// The frame of a facing pair (DESIGN §1, directions measured from the
+// pair's own axis): origin at ci's midpoint, axis u bisecting the range of
+// directions of lines meeting both, so that the range is
+// [-delta_theta, delta_theta] with delta_theta < pi/2 and the slope
+// tan(phi) is a monotone, well-conditioned parameter inside it.
+struct PairFrame {
+    Vec2 origin, u;
+    double theta_u = 0;      // absolute direction of u
+    double delta_theta = 0;  // half the range of directions
+
+    PairFrame(const Segment& ci, const Segment& cj) : origin(ci.midpoint()) {
+        Vec2 u0 = cj.midpoint() - origin;
+        u0 = u0 / norm(u0);
+        double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+        for (Vec2 A : {ci.a, ci.b})
+            for (Vec2 C : {cj.a, cj.b}) {
+                const Vec2 w = C - A;
+                if (w == Vec2{}) continue;
+                const double phi = std::atan2(cross(u0, w), dot(u0, w));
+                lo = std::min(lo, phi);
+                hi = std::max(hi, phi);
+            }
+        const double mid = 0.5 * (lo + hi);
+        u = {u0.x * std::cos(mid) - u0.y * std::sin(mid), u0.x * std::sin(mid) + u0.y * std::cos(mid)};
+        theta_u = std::atan2(u.y, u.x);
+        delta_theta = 0.5 * (hi - lo);
+    }
+    Vec2 local(Vec2 P) const {
+        const Vec2 d = P - origin;
+        return {dot(d, u), dot(d, rot90(u))};
+    }
+};
+
+// Clips the candidate pieces to the shaft into `out`. Returns true when one
+// of them closes the shaft on its own (the answer is then 0).
+inline bool clip_candidates(const Shaft& shaft, const Segment* candidates, size_t count, std::vector<Segment>& out) {
+    const double size = shaft.box.diagonal();
+    out.clear();
+    for (size_t k = 0; k < count; ++k) {
+        Box bb;
+        bb.add(candidates[k]);
+        if (!shaft.overlaps(bb)) continue;
+        if (add_blocker(shaft, candidates[k], size, out)) return true;
+    }
     return false;
 }
 
