@@ -2,12 +2,16 @@
 /// The cluster hierarchy: a binary tree of axis-aligned boxes over the scene's
 /// segments, shared by the visibility module and the hierarchical solver.
 ///
-/// Built top-down in O(N log N): each node splits its segments at the median
-/// centroid along the longer axis of the centroids' box (std::nth_element,
-/// linear per level, log N levels). The median keeps the tree balanced
-/// (depth <= ceil(log2(N / leaf_size)) + 1) whatever the distribution, so
-/// no query degrades to a linear scan; boxes of siblings may overlap, which
-/// costs a little culling power but never correctness.
+/// Built top-down: each node splits its segments along the longer axis of
+/// the centroids' box at the plane (among 16 bins) that minimizes the
+/// surface-area heuristic, sum over the children of box perimeter x count.
+/// That plane separates gaps and outliers, so a compact group of blockers
+/// away from the walls becomes one node (what the multi-scale criterion
+/// needs). Unbalanced splits are allowed only down to depth
+/// 2 ceil(log2(N + 1)) + 4; deeper, or when no plane separates anything,
+/// the split is at the median centroid. So depth <= that limit + log2(N)
+/// and the build is O(N log N). Sibling boxes may overlap, which costs a
+/// little culling power but never correctness.
 #include <cstdint>
 #include <vector>
 

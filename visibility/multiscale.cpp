@@ -424,11 +424,121 @@ struct MixedIntegral {
     }
 };
 
+// The window-aware L1 bound (GammaRule::Bound). Replacing cluster C's 0/1
+// transmittance tau by tau_bar changes L_i F by
+//   1/2 Integral_theta Integral_{P_C} (tau - tau_bar) w dp dtheta,
+// w in [0, 1] the overlap window times everything else's transmittance.
+// tau - tau_bar integrates to 0 over C's lines (P_C), so wherever w is
+// constant over P_C (C's shadow inside the window, and no other piece's
+// shadow meeting C's) the change is exactly 0; elsewhere w may be shifted by
+// 1/2, giving at most ||tau - tau_bar||_L1 / 2. With several approximated
+// clusters the telescoped difference of products has one such term per
+// cluster. So
+//   |error in F| <= 1/(4 L_i) Integral I_C(theta) L1(theta) dtheta
+//                 + 1/(2 L_i) Integral delta_p |interpolation error| dtheta,
+// I_C = 1 where C's shadow sticks out of the window or meets another
+// piece's. I_C is sampled at the table's directions and widened by one
+// sample on each side (it changes only at critical directions, between
+// which it is constant).
+struct Interactions {
+    const PairGeometry& g;
+    const std::vector<Segment>& pieces;
+    const std::vector<int32_t>& piece_pos;
+    long k_first = 0, k_last = -1;  // sample indices covering the range, widened
+    std::vector<double> lo, hi;     // window per sample
+    std::vector<std::vector<double>> starts, ends;  // sorted shadow ends per sample
+
+    static constexpr double pi = 3.14159265358979323846;
+    static double step() { return pi / ClusterTables::directions; }
+    static double theta_of(long k) { return (static_cast<double>(k) + 0.5) * step(); }
+
+    Interactions(const PairGeometry& geo, const std::vector<Segment>& p, const std::vector<int32_t>& pos, bool needed)
+        : g(geo), pieces(p), piece_pos(pos) {
+        if (!needed) return;
+        const double t_lo = g.theta_u - g.delta_theta, t_hi = g.theta_u + g.delta_theta;
+        k_first = static_cast<long>(std::floor(t_lo / step() - 0.5)) - 1;
+        k_last = static_cast<long>(std::floor(t_hi / step() - 0.5)) + 2;
+        const size_t n = static_cast<size_t>(k_last - k_first + 1);
+        lo.resize(n);
+        hi.resize(n);
+        starts.resize(n);
+        ends.resize(n);
+        for (size_t q = 0; q < n; ++q) {
+            const double th = theta_of(k_first + static_cast<long>(q));
+            const double nx = -std::sin(th), ny = std::cos(th);
+            const double a0 = nx * g.ci.a.x + ny * g.ci.a.y, a1 = nx * g.ci.b.x + ny * g.ci.b.y;
+            const double c0 = nx * g.cj.a.x + ny * g.cj.a.y, c1 = nx * g.cj.b.x + ny * g.cj.b.y;
+            lo[q] = std::max(std::min(a0, a1), std::min(c0, c1));
+            hi[q] = std::min(std::max(a0, a1), std::max(c0, c1));
+            starts[q].resize(pieces.size());
+            ends[q].resize(pieces.size());
+            for (size_t b = 0; b < pieces.size(); ++b) {
+                const double pa = nx * pieces[b].a.x + ny * pieces[b].a.y;
+                const double pb = nx * pieces[b].b.x + ny * pieces[b].b.y;
+                starts[q][b] = std::min(pa, pb);
+                ends[q][b] = std::max(pa, pb);
+            }
+            std::sort(starts[q].begin(), starts[q].end());
+            std::sort(ends[q].begin(), ends[q].end());
+        }
+    }
+
+    // Does C (box, own pieces [own_lo, own_hi) in `pieces`) interact at sample q?
+    bool interacts(size_t q, const Box& box, size_t own_lo, size_t own_hi) const {
+        if (!(hi[q] > lo[q])) return false;  // no line at this direction: w = 0, constant
+        const double th = theta_of(k_first + static_cast<long>(q));
+        const double nx = -std::sin(th), ny = std::cos(th);
+        const double c[4] = {nx * box.lo.x + ny * box.lo.y, nx * box.hi.x + ny * box.lo.y,
+                             nx * box.hi.x + ny * box.hi.y, nx * box.lo.x + ny * box.hi.y};
+        const double a = std::min({c[0], c[1], c[2], c[3]}), b = std::max({c[0], c[1], c[2], c[3]});
+        if (a < lo[q] || b > hi[q]) return true;  // the window cuts C's shadow
+        // Pieces whose shadow meets (a, b): all minus those ending at or
+        // before a, minus those starting at or after b; then C's own.
+        const auto& st = starts[q];
+        const auto& en = ends[q];
+        const long meeting = static_cast<long>(st.size()) -
+                             static_cast<long>(std::upper_bound(en.begin(), en.end(), a) - en.begin()) -
+                             static_cast<long>(st.end() - std::lower_bound(st.begin(), st.end(), b));
+        long own = 0;
+        for (size_t k = own_lo; k < own_hi; ++k) {
+            const double pa = nx * pieces[k].a.x + ny * pieces[k].a.y, pb = nx * pieces[k].b.x + ny * pieces[k].b.y;
+            if (std::max(pa, pb) > a && std::min(pa, pb) < b) ++own;
+        }
+        return meeting > own;
+    }
+
+    double bound(const ClusterTables& tables, int node, const Box& box, size_t own_lo, size_t own_hi) const {
+        const ClusterTable& t = tables.table(node);
+        const size_t n = lo.size();
+        std::vector<char> I(n);
+        for (size_t q = 0; q < n; ++q) I[q] = interacts(q, box, own_lo, own_hi);
+        const double t_lo = g.theta_u - g.delta_theta, t_hi = g.theta_u + g.delta_theta;
+        auto sample = [&](long k) {
+            return static_cast<size_t>(((k % ClusterTables::directions) + ClusterTables::directions) %
+                                       ClusterTables::directions);
+        };
+        double l1_part = 0, interp_part = 0;
+        for (size_t q = 1; q + 2 < n; ++q) {
+            const long k = k_first + static_cast<long>(q);
+            const double a = std::max(theta_of(k), t_lo), b = std::min(theta_of(k + 1), t_hi);
+            if (!(b > a)) continue;
+            const size_t s0 = sample(k), s1 = sample(k + 1);
+            const double err = std::abs(t.tau_bar[s1] - t.tau_bar[s0]);
+            const double dp = std::max(t.delta_p[s0], t.delta_p[s1]);
+            if (I[q - 1] || I[q] || I[q + 1] || I[q + 2])
+                l1_part += (b - a) * (std::max(t.L1[s0], t.L1[s1]) + 3 * dp * err);
+            interp_part += (b - a) * dp * err;
+        }
+        return l1_part / (4 * g.L_i) + interp_part / (2 * g.L_i);
+    }
+};
+
 }  // namespace
 
 const char* gamma_rule_name(GammaRule r) {
     switch (r) {
         case GammaRule::Bound: return "bound";
+        case GammaRule::BoundUniform: return "bound-uniform";
         case GammaRule::Paper: return "paper";
         case GammaRule::LineSpace: return "line-space";
     }
@@ -505,38 +615,68 @@ MultiscaleResult MultiscaleVisibility::form_factor_skipping(const Segment& i, co
         return (pos >= skip_a.first && pos < skip_a.first + skip_a.count) ||
                (pos >= skip_b.first && pos < skip_b.first + skip_b.count);
     };
-    std::vector<Segment>& exact = ws.blockers;
-    exact.clear();
-    std::vector<Approx> approx;
-    double bound = 0;
+    // 1a. Every blocker piece in the shaft, with its position in the
+    //     hierarchy's order (a left-first walk visits positions in order).
+    std::vector<Segment> pieces;
+    std::vector<int32_t> piece_pos;
     bool separated = false;
     auto& stack = ws.stack;
     stack.clear();
     if (m_hierarchy->root() >= 0) stack.push_back(m_hierarchy->root());
     while (!stack.empty() && !separated) {
-        const int k = stack.back();
+        const ClusterNode& n = m_hierarchy->node(stack.back());
         stack.pop_back();
-        const ClusterNode& n = m_hierarchy->node(k);
         ++out.clusters_visited;
         if (!shaft.overlaps(n.box)) continue;
-        if (n.leaf()) {
-            for (int q = n.first; q < n.first + n.count && !separated; ++q) {
-                if (skipped(q)) continue;
-                const int s = m_hierarchy->order()[static_cast<size_t>(q)];
-                separated = add_blocker(shaft, m_hierarchy->segments()[static_cast<size_t>(s)], size, exact);
-            }
+        if (!n.leaf()) {
+            stack.push_back(n.child[1]);
+            stack.push_back(n.child[0]);
             continue;
         }
-        if (eps > 0 && !holds(n, skip_a) && !holds(n, skip_b) && shaft.contains(n.box)) {
-            const double gamma = criteria_for(*m_tables, k, g).value(rule);
-            if (gamma < eps) {
-                approx.push_back({k, {}});
-                bound += gamma;
+        for (int q = n.first; q < n.first + n.count && !separated; ++q) {
+            if (skipped(q)) continue;
+            const int s = m_hierarchy->order()[static_cast<size_t>(q)];
+            const size_t before = pieces.size();
+            separated = add_blocker(shaft, m_hierarchy->segments()[static_cast<size_t>(s)], size, pieces);
+            if (pieces.size() > before) piece_pos.push_back(q);
+        }
+    }
+    std::vector<Segment>& exact = ws.blockers;
+    exact.clear();
+    std::vector<Approx> approx;
+    double bound = 0;
+    if (!separated) {
+        // 1b. Decide, top down: approximate a cluster wholly inside the shaft
+        //     whose criterion is below eps; the pieces of the rest are exact.
+        const Interactions inter(g, pieces, piece_pos, eps > 0 && rule == GammaRule::Bound);
+        stack.push_back(m_hierarchy->root());
+        while (!stack.empty()) {
+            const int k = stack.back();
+            stack.pop_back();
+            const ClusterNode& n = m_hierarchy->node(k);
+            const auto lo = std::lower_bound(piece_pos.begin(), piece_pos.end(), n.first);
+            const auto hi = std::lower_bound(lo, piece_pos.end(), n.first + n.count);
+            if (lo == hi) continue;  // no piece of this node in the shaft
+            if (eps > 0 && !n.leaf() && !holds(n, skip_a) && !holds(n, skip_b) && shaft.contains(n.box)) {
+                double gamma;
+                if (rule == GammaRule::Bound)
+                    gamma = inter.bound(*m_tables, k, n.box, static_cast<size_t>(lo - piece_pos.begin()),
+                                        static_cast<size_t>(hi - piece_pos.begin()));
+                else
+                    gamma = criteria_for(*m_tables, k, g).value(rule);
+                if (gamma < eps) {
+                    approx.push_back({k, {}, nullptr});
+                    bound += gamma;
+                    continue;
+                }
+            }
+            if (n.leaf()) {
+                for (auto it = lo; it != hi; ++it) exact.push_back(pieces[static_cast<size_t>(it - piece_pos.begin())]);
                 continue;
             }
+            stack.push_back(n.child[1]);
+            stack.push_back(n.child[0]);
         }
-        stack.push_back(n.child[1]);
-        stack.push_back(n.child[0]);
     }
     stats.clusters_visited += out.clusters_visited;
     ++stats.queries;
@@ -552,8 +692,8 @@ MultiscaleResult MultiscaleVisibility::form_factor_skipping(const Segment& i, co
 
     // 2. Nothing approximated: the exact integral.
     if (approx.empty()) {
-        const std::vector<Segment> pieces = exact;  // exchange_with_blockers reuses ws.blockers
-        out.F = ExactVisibility::exchange_with_blockers(g.ci, g.cj, pieces, ws, stats) / g.L_i;
+        const std::vector<Segment> exact_copy = exact;  // exchange_with_blockers reuses ws.blockers
+        out.F = ExactVisibility::exchange_with_blockers(g.ci, g.cj, exact_copy, ws, stats) / g.L_i;
         return out;
     }
 

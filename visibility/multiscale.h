@@ -27,13 +27,17 @@ namespace flatrad {
 /// Which criterion decides (and bounds) an approximation. All are errors
 /// in F_ij (absolute), for one cluster.
 enum class GammaRule {
-    /// Rigorous line-space bound with L1 norms: the error of tau_bar over
-    /// the pair's directions is at most (the weight w in [0, 1] shifted by
-    /// 1/2, as tau - tau_bar integrates to 0 over the box's lines)
-    ///   1/(4 L_i) Integral ||tau_C - tau_bar||_L1 dtheta <= delta_theta max L1 / (2 L_i),
-    /// L1 = 2 delta_p tau_bar (1 - tau_bar) exactly for opaque segments,
-    /// plus the table's interpolation error. The default.
+    /// Line-space bound with L1 norms, aware of where the cluster interacts
+    /// (the default). tau - tau_bar integrates to zero over the cluster's
+    /// lines, so the approximation is exact at every direction where the
+    /// cluster's shadow lies inside the overlap window and meets no other
+    /// piece's shadow; elsewhere its error is at most ||tau - tau_bar||_L1 / 2.
+    /// Error in F <= 1/(4 L_i) Integral_{interacting} L1 dtheta plus the
+    /// table's interpolation error (see Interactions in multiscale.cpp).
     Bound,
+    /// The same bound assuming interaction at every direction:
+    /// delta_theta max L1 / (2 L_i) plus interpolation. Simpler, looser.
+    BoundUniform,
     /// The paper's Gamma as written: (2 delta_theta sqrt(delta_p) / r_min) |T| (R1 + R2),
     /// with the filtered R1, R2 at theta_12.
     Paper,

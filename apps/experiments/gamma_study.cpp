@@ -23,7 +23,7 @@ int main(int argc, char** argv) {
     const int configs = argc > 1 ? std::atoi(argv[1]) : 1000;
     const unsigned long seed = argc > 2 ? std::strtoul(argv[2], nullptr, 10) : 1;
     const double eps_list[] = {1e-4, 1e-3, 1e-2, 3e-2};
-    const GammaRule rules[] = {GammaRule::Bound, GammaRule::Paper, GammaRule::LineSpace};
+    const GammaRule rules[] = {GammaRule::Bound, GammaRule::BoundUniform, GammaRule::Paper, GammaRule::LineSpace};
     // Rounding floor: both values are integrals exact to ~1e-15 of F.
     constexpr double rounding_floor = 1e-12;
 
@@ -34,7 +34,7 @@ int main(int argc, char** argv) {
         double time_s = 0;
         double worst_excess = 0;  // largest error - bound among failures
     };
-    Tally tally[3][4];
+    Tally tally[4][4];
     double exact_time = 0;
     std::mt19937_64 rng(seed);
     for (int t = 0; t < configs; ++t) {
@@ -48,7 +48,7 @@ int main(int argc, char** argv) {
         auto t0 = std::chrono::steady_clock::now();
         const double exact = ex.form_factor(c.i, c.j, 0, 1, ws, st);
         exact_time += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        for (int r = 0; r < 3; ++r)
+        for (int r = 0; r < 4; ++r)
             for (int e = 0; e < 4; ++e) {
                 t0 = std::chrono::steady_clock::now();
                 const MultiscaleResult res = ms.form_factor(c.i, c.j, 0, 1, eps_list[e], rules[r], ws, st);
@@ -72,7 +72,7 @@ int main(int argc, char** argv) {
                 exact_time);
     std::printf("%-11s %-8s %6s %13s %9s %12s %12s %12s %10s\n", "rule", "eps", "runs", "approximating",
                 "failures", "worst err/bd", "mean err/bd", "worst excess", "time s");
-    for (int r = 0; r < 3; ++r)
+    for (int r = 0; r < 4; ++r)
         for (int e = 0; e < 4; ++e) {
             const Tally& y = tally[r][e];
             std::printf("%-11s %-8g %6ld %13ld %9ld %12.3g %12.3g %12.3g %10.3f\n", gamma_rule_name(rules[r]),

@@ -55,8 +55,10 @@ TEST_CASE("hierarchy: every segment in one leaf, boxes nest, depth is logarithmi
                 }
             }
             for (int c : seen) CHECK(c == 1);
-            // Median splits: depth <= ceil(log2(n / leaf)) + 1 levels.
-            const int bound = static_cast<int>(std::ceil(std::log2(std::max(1.0, double(n) / leaf)))) + 1;
+            // Heuristic splits down to 2 ceil(log2(n + 1)) + 4, median splits
+            // below: depth <= that + ceil(log2(n / leaf)) + 1 levels.
+            const int bound = 2 * static_cast<int>(std::ceil(std::log2(double(n) + 1))) + 4 +
+                              static_cast<int>(std::ceil(std::log2(std::max(1.0, double(n) / leaf)))) + 1;
             CAPTURE(n);
             CAPTURE(leaf);
             CHECK(h.depth() <= bound);
@@ -91,6 +93,28 @@ TEST_CASE("hierarchy: box queries find exactly what a linear scan finds") {
         CHECK(found == expected);
         CHECK(visited >= 1);
     }
+}
+
+TEST_CASE("hierarchy: a compact cloud between two far walls becomes one node") {
+    // Two long walls far apart and a dense cloud between them: the heuristic
+    // peels the walls off, so some node holds exactly the cloud.
+    std::mt19937_64 rng(9);
+    std::uniform_real_distribution<double> U(0, 1);
+    std::vector<Segment> segs{{{-5, 0}, {5, 0}}, {{5, 10}, {-5, 10}}};
+    for (int k = 0; k < 300; ++k) {
+        const Vec2 c{U(rng) - 0.5, 5 + U(rng) - 0.5};
+        segs.push_back({c, c + Vec2{0.01, 0.005}});
+    }
+    const Hierarchy h(segs, 2);
+    bool found = false;
+    for (const ClusterNode& nd : h.nodes()) {
+        if (nd.count != 300) continue;
+        bool only_cloud = true;
+        for (int k = nd.first; k < nd.first + nd.count; ++k)
+            if (h.order()[static_cast<size_t>(k)] < 2) only_cloud = false;
+        found = found || only_cloud;
+    }
+    CHECK(found);
 }
 
 TEST_CASE("hierarchy: coincident segments do not split forever") {

@@ -1,0 +1,279 @@
+// Tests apps/cli/sweep_command.h (`flatrad sweep`, driven in-process through
+// run_cli) and the plot writer it uses, apps/cli/svg_plot.h.
+#include "cli/sweep_command.h"
+
+#include <unistd.h>
+
+#include <atomic>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <doctest/doctest.h>
+
+#include "cli/cli.h"
+#include "cli/svg_plot.h"
+#include "cli/usage_error.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Run {
+    int status = -1;
+    std::string out, err;
+};
+
+Run run(const std::vector<std::string>& args) {
+    std::ostringstream out, err;
+    Run r;
+    r.status = flatrad::run_cli(args, out, err);
+    r.out = out.str();
+    r.err = err.str();
+    return r;
+}
+
+bool is_one_error_line(const std::string& err) {
+    return err.rfind("error: ", 0) == 0 && err.find('\n') == err.size() - 1;
+}
+
+class TempDir {
+public:
+    TempDir() {
+        static std::atomic<int> counter{0};
+        m_path = fs::temp_directory_path() /
+                 ("flatrad_sweep_test_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
+        fs::remove_all(m_path);
+        fs::create_directories(m_path);
+    }
+    ~TempDir() {
+        std::error_code ec;
+        fs::remove_all(m_path, ec);
+    }
+    TempDir(const TempDir&) = delete;
+    TempDir& operator=(const TempDir&) = delete;
+    std::string path(const std::string& name) const { return (m_path / name).string(); }
+    const fs::path& dir() const { return m_path; }
+
+private:
+    fs::path m_path;
+};
+
+std::string read_text(const std::string& path) {
+    std::ifstream in(path);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+std::vector<std::string> split(const std::string& s, char sep) {
+    std::vector<std::string> out;
+    std::string field;
+    std::istringstream in(s);
+    while (std::getline(in, field, sep)) out.push_back(field);
+    return out;
+}
+
+struct Csv {
+    std::vector<std::string> comments, header;
+    std::vector<std::vector<double>> rows;
+};
+
+Csv parse_csv(const std::string& text) {
+    Csv csv;
+    for (const std::string& line : split(text, '\n')) {
+        if (line.empty()) continue;
+        if (line[0] == '#') {
+            csv.comments.push_back(line);
+        } else if (csv.header.empty()) {
+            csv.header = split(line, ',');
+        } else {
+            std::vector<double> row;
+            for (const std::string& f : split(line, ',')) row.push_back(std::stod(f));
+            csv.rows.push_back(row);
+        }
+    }
+    return csv;
+}
+
+const std::string fig5 = std::string(FLATRAD_DATA_DIR) + "/soler95-fig5.json";
+
+const std::vector<std::string> expected_header = {
+    "eps", "F", "F_exact", "error", "relative_error", "error_bound", "time_s", "clusters_visited",
+    "clusters_approximated"};
+
+// With nothing approximated the multiscale path is the exact one; only the
+// order of a few compensated sums may differ: 1e-12 relative is far above
+// that rounding and far below any approximation's effect.
+constexpr double same_value_tol = 1e-12;
+
+}  // namespace
+
+TEST_CASE("parse_eps_range: N values from LO to HI, both ends included") {
+    const std::vector<double> e = flatrad::parse_eps_range("0:0.04:5");
+    REQUIRE(e.size() == 5);
+    CHECK(e.front() == 0.0);
+    CHECK(e.back() == 0.04);
+    CHECK(e[2] == doctest::Approx(0.02).epsilon(1e-15));
+    CHECK(flatrad::parse_eps_range("0:0.04:800").size() == 800);
+    CHECK(flatrad::parse_eps_range("0.5:0.5:3") == std::vector<double>{0.5, 0.5, 0.5});
+    CHECK(flatrad::parse_eps_range("0.25:1:1") == std::vector<double>{0.25});  // N = 1: LO alone
+    CHECK(flatrad::parse_eps_range("1e-3:2e-3:2") == std::vector<double>{1e-3, 2e-3});
+    CHECK(flatrad::parse_eps_range("0:1:100000").size() == 100000);
+
+    for (const char* bad : {"", "0:1", "0:1:2:3", "1:0:3", "-1:1:3", "0:1:0", "0:1:-2", "0:1:2.5", "0:1:100001",
+                            "a:1:2", "0:b:2", "0:1:x", "0:inf:3", "nan:1:3", " 0:1:3", "0:1:3 ", "0::3", "::"}) {
+        CAPTURE(bad);
+        CHECK_THROWS_AS(flatrad::parse_eps_range(bad), flatrad::UsageError);
+    }
+}
+
+TEST_CASE("sweep: soler95 fig. 5, five eps, CSV and three SVG plots") {
+    TempDir tmp;
+    const std::string csv_path = tmp.path("fig5.csv"), prefix = tmp.path("fig5");
+    const Run r = run({"sweep", fig5, "--from", "S1", "--to", "S2", "--eps", "0:0.04:5", "--repeat", "1", "-o",
+                       csv_path, "--svg", prefix, "--quiet"});
+    REQUIRE(r.status == 0);
+    CHECK(r.err.empty());  // --quiet
+    CHECK(r.out.empty());  // the table went to -o
+
+    const Csv csv = parse_csv(read_text(csv_path));
+    REQUIRE(csv.comments.size() == 1);
+    CHECK(csv.comments[0].find("soler95") != std::string::npos);
+    CHECK(csv.comments[0].find("gamma bound") != std::string::npos);
+    CHECK(csv.header == expected_header);
+    REQUIRE(csv.rows.size() == 5);
+    const double F_exact = csv.rows[0][2];
+    CHECK(F_exact > 0);
+    for (const auto& row : csv.rows) {
+        REQUIRE(row.size() == 9);
+        CAPTURE(row[0]);
+        CHECK(row[2] == F_exact);                              // one exact value
+        CHECK(row[3] == std::abs(row[1] - F_exact));           // round-trip doubles: exactly
+        CHECK(row[3] <= row[5] + 1e-12);                       // the claimed bound holds
+        CHECK(row[6] > 0);                                     // a time
+        CHECK(row[7] >= row[8]);                               // approximated clusters were visited
+    }
+    CHECK(csv.rows[0][0] == 0.0);
+    CHECK(csv.rows[0][3] <= same_value_tol * F_exact);  // eps = 0 is exact
+    CHECK(csv.rows[0][8] == 0.0);                        // and approximates nothing
+    CHECK(csv.rows[4][0] == 0.04);
+
+    for (const char* kind : {"-time.svg", "-F.svg", "-error.svg"}) {
+        CAPTURE(kind);
+        const std::string svg = read_text(prefix + kind);
+        CHECK(svg.rfind("<svg", 0) == 0);
+        CHECK(svg.find("</svg>") != std::string::npos);
+        CHECK(svg.find("soler95") != std::string::npos);  // title names the scene
+        CHECK(svg.find("gamma bound") != std::string::npos);
+    }
+    // Nothing but the four outputs: no temporary file left behind.
+    int files = 0;
+    for ([[maybe_unused]] const auto& entry : fs::directory_iterator(tmp.dir())) ++files;
+    CHECK(files == 4);
+}
+
+TEST_CASE("sweep: table on stdout without -o, summary on stderr, any gamma") {
+    for (const char* gamma : {"bound", "paper", "line-space"}) {
+        CAPTURE(gamma);
+        const Run r = run({"sweep", fig5, "--from", "S1", "--to", "S2", "--eps", "0:0.01:2", "--repeat", "1",
+                           "--gamma", gamma});
+        REQUIRE(r.status == 0);
+        const Csv csv = parse_csv(r.out);
+        CHECK(csv.header == expected_header);
+        CHECK(csv.rows.size() == 2);
+        CHECK(csv.comments.at(0).find(std::string("gamma ") + gamma) != std::string::npos);
+        CHECK(r.err.find("exact: F = ") != std::string::npos);
+        CHECK(r.err.find("largest eps with relative error <= 1%") != std::string::npos);
+        CHECK(r.err.find("error > error_bound at") != std::string::npos);
+    }
+}
+
+TEST_CASE("sweep: bad arguments give status 2, one line, and write nothing") {
+    TempDir tmp;
+    const std::string csv = tmp.path("x.csv");
+    const std::vector<std::vector<std::string>> bad = {
+        {"sweep"},                                                            // usage
+        {"sweep", fig5, "--from", "S1"},                                      // missing --to
+        {"sweep", fig5, "--from", "S1", "--to", "S2", "--eps", "0:0.04"},     // two fields
+        {"sweep", fig5, "--from", "S1", "--to", "S2", "--eps", "0.04:0:5"},   // HI < LO
+        {"sweep", fig5, "--from", "S1", "--to", "S2", "--eps", "0:1:0"},      // N = 0
+        {"sweep", fig5, "--from", "S1", "--to", "S2", "--eps", "0:1:1e9"},    // N not an integer
+        {"sweep", fig5, "--from", "S1", "--to", "S2", "--eps", "0:1:200000"}, // N too large
+        {"sweep", fig5, "--from", "S1", "--to", "nope"},                      // unknown surface
+        {"sweep", fig5, "--from", "S1,", "--to", "S2"},                       // empty name
+        {"sweep", fig5, "--from", "S1", "--to", "S2", "--gamma", "magic"},
+        {"sweep", fig5, "--from", "S1", "--to", "S2", "--repeat", "0"},
+        {"sweep", fig5, "--from", "S1", "--to", "S2", "-o", tmp.path("no/such/dir.csv")},
+        {"sweep", fig5, "--from", "S1", "--to", "S2", "--svg", tmp.path("no/such/prefix")},
+        {"sweep", tmp.path("missing.json"), "--from", "S1", "--to", "S2"},
+    };
+    for (const auto& args : bad) {
+        std::string joined;
+        for (const auto& a : args) joined += a + " ";
+        CAPTURE(joined);
+        const Run r = run(args);
+        CHECK(r.status == 2);
+        CHECK(is_one_error_line(r.err));
+        CHECK(r.out.empty());
+    }
+    const Run eps = run({"sweep", fig5, "--from", "S1", "--to", "S2", "--eps", "1:0:3", "-o", csv});
+    CHECK(eps.err.find("--eps") != std::string::npos);
+    CHECK_FALSE(fs::exists(csv));
+}
+
+TEST_CASE("svg_plot: linear ticks are round and inside the range") {
+    const std::vector<double> t = flatrad::linear_ticks(0, 0.04);
+    REQUIRE(t.size() == 5);
+    CHECK(t.front() == 0.0);
+    CHECK(t.back() == doctest::Approx(0.04));
+    CHECK(flatrad::linear_ticks(1, 1).empty());
+    for (double v : flatrad::linear_ticks(0.0391, 0.0417)) {
+        CHECK(v >= 0.0391 - 1e-12);
+        CHECK(v <= 0.0417 + 1e-12);
+    }
+}
+
+TEST_CASE("svg_plot: a standalone document, and log axes skip what they cannot draw") {
+    flatrad::SvgPlot p;
+    p.title = "a <title> & \"quotes\"";
+    p.x.scale = flatrad::AxisScale::Log;
+    p.y.scale = flatrad::AxisScale::Log;
+    flatrad::PlotSeries s;
+    s.label = "points";
+    s.mark = flatrad::PlotMark::Points;
+    s.x = {1e-3, 1e-2, 0.0, 1.0};
+    s.y = {1.0, 0.0, 5.0, NAN};  // only the first point is drawable
+    p.series = {s};
+    flatrad::PlotRefLine v;
+    v.vertical = true;
+    v.value = 0.05;
+    p.lines = {v};
+    const std::string svg = flatrad::render_svg_plot(p);
+    CHECK(svg.rfind("<svg", 0) == 0);
+    CHECK(svg.size() >= 7);
+    CHECK(svg.substr(svg.size() - 7) == "</svg>\n");
+    CHECK(svg.find("a &lt;title&gt; &amp; &quot;quotes&quot;") != std::string::npos);
+    CHECK(svg.find("<title>") == std::string::npos);
+    CHECK(svg.find("nan") == std::string::npos);
+    CHECK(svg.find("inf") == std::string::npos);
+    size_t circles = 0;
+    for (size_t k = svg.find("<circle"); k != std::string::npos; k = svg.find("<circle", k + 1)) ++circles;
+    CHECK(circles == 2);  // the one drawable point and its legend swatch
+
+    flatrad::SvgPlot bad;
+    flatrad::PlotSeries ragged;
+    ragged.x = {1, 2};
+    ragged.y = {1};
+    bad.series = {ragged};
+    CHECK_THROWS_AS(flatrad::render_svg_plot(bad), std::invalid_argument);
+    flatrad::SvgPlot no_y2;
+    flatrad::PlotSeries right;
+    right.right_axis = true;
+    no_y2.series = {right};
+    CHECK_THROWS_AS(flatrad::render_svg_plot(no_y2), std::invalid_argument);
+}
