@@ -9,6 +9,7 @@
 
 #include "cli/formfactor_command.h"
 #include "cli/solve_command.h"
+#include "cli/sweep_command.h"
 #include "cli/usage_error.h"
 #include "engine/error.h"
 
@@ -52,6 +53,7 @@ struct Commands {
     CLI::App* formfactor_cmd = nullptr;
     CLI::App* compare_cmd = nullptr;
     CLI::App* sweep_cmd = nullptr;
+    SweepArgs sweep;
 };
 
 void add_solve(CLI::App& app, Commands& c) {
@@ -146,13 +148,7 @@ void add_not_yet(CLI::App& app, Commands& c) {
         "Planned: flatrad compare SCENE [--eps E ...]. Not available yet: it needs the "
         "hierarchical solver. Any arguments are accepted and the command exits with status 2.");
     c.compare_cmd->allow_extras();
-    c.sweep_cmd = app.add_subcommand(
-        "sweep", "Error against run time over a range of tolerances (not available yet).");
-    c.sweep_cmd->footer(
-        "Planned: a table and a plot of error against run time over a range of tolerances. Not "
-        "available yet: it needs the hierarchical solver and multi-scale visibility. Any "
-        "arguments are accepted and the command exits with status 2.");
-    c.sweep_cmd->allow_extras();
+    c.sweep_cmd = add_sweep_command(app, c.sweep);  // cli/sweep_command.h
 }
 
 int dispatch(Commands& c, std::ostream& out, std::ostream& err) {
@@ -167,10 +163,7 @@ int dispatch(Commands& c, std::ostream& out, std::ostream& err) {
     }
     if (c.compare_cmd->parsed())
         throw UsageError("compare: not available yet (the hierarchical solver has not landed)");
-    if (c.sweep_cmd->parsed())
-        throw UsageError(
-            "sweep: not available yet (the hierarchical solver and the multi-scale visibility "
-            "module have not landed)");
+    if (c.sweep_cmd->parsed()) return run_sweep(c.sweep, out, err);
     throw UsageError("a command is required: solve, formfactor, compare or sweep (see flatrad --help)");
 }
 

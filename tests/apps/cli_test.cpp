@@ -147,6 +147,7 @@ TEST_CASE("cli: bad arguments give status 2 and one error line") {
         {"formfactor", scene, "--from", "lamp"},     // missing --to
         {"formfactor", scene, "--from", "lamp,", "--to", "plate"},  // empty name
         {"formfactor", scene, "--from", "lamp", "--to", "plate", "--method", "magic"},
+        {"sweep"},                                   // missing SCENE, --from, --to
     };
     for (const auto& args : bad) {
         std::string joined;
@@ -172,8 +173,7 @@ TEST_CASE("cli: methods and commands that have not landed say so") {
     for (const auto& args : std::vector<std::vector<std::string>>{
              {"solve", scene, "--svg", tmp.path("x.svg")},
              {"compare", scene},
-             {"compare", scene, "--eps", "0.01"},
-             {"sweep"}}) {
+             {"compare", scene, "--eps", "0.01"}}) {
         const Run r = run(args);
         CHECK(r.status == 2);
         CHECK(is_one_error_line(r.err));
