@@ -2,6 +2,7 @@
 /// The shaft of a facing pair (DESIGN.md §1): the convex hull of the two
 /// mutually clipped patches, and the clipping of blockers to it. Shared by
 /// the exact and the multi-scale visibility. Internal to visibility/.
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
@@ -12,10 +13,14 @@
 namespace flatrad::shaft_detail {
 
 // A blocker piece closer than this to the line of a patch, relative to the
-// shaft's size, lies along the patch (overlapping or touching segments): it
+// local scale, lies along the patch (overlapping or touching segments): it
 // cannot stop a line that crosses the shaft's interior, so it is dropped.
-// Clipping rounds endpoints by a few ulps of the shaft size; 1e-13 is a
-// hundred times that and still far below any real gap.
+// The local scale of a piece end x is that of the numbers its distance is
+// made of: |x| and |p| (p the nearer end of the patch; clipping rounds
+// points by a few ulps of their coordinates) and |x - p| (orient's own
+// rounding). Not the shaft's size: beside a 1e33-long wall, a lamp 1 away
+// from the other patch is not on its line. 1e-13 is a hundred times the
+// rounding and still far below any real gap.
 inline constexpr double on_edge_tolerance = 1e-13;
 
 // Slack, relative to the overlap width, when deciding whether a critical
@@ -94,22 +99,28 @@ struct Shaft {
 // Adds s, clipped to the shaft, to the blockers. Returns true when the piece
 // alone closes the shaft: it runs from one side edge (A1 -> C0, edge 1) to
 // the other (C1 -> A0, edge 3), so every line from i to j crosses it.
-inline bool add_blocker(const Shaft& shaft, const Segment& s, double size, std::vector<Segment>& blockers) {
+// `size` (the shaft's diagonal) is no longer used: tolerances are local.
+inline bool add_blocker(const Shaft& shaft, const Segment& s, [[maybe_unused]] double size,
+                        std::vector<Segment>& blockers) {
     Segment piece;
     int enter = -1, leave = -1;
     if (!shaft.clip(s, piece, enter, leave)) return false;
     // Drop pieces lying along patch i (edge 0) or patch j (edge 2); note
-    // whether either end touches a patch's line. orient(p, q, x) is |q - p|
-    // times x's distance to the line, so the distance bound on_edge_tolerance
-    // x size becomes a bound on orient through the patch's own length (not
-    // the shaft's: a 1e-8 patch facing a 1e8 one would otherwise see a
-    // blocker 0.5 away as lying on its line).
-    const double tol = on_edge_tolerance * size;
+    // whether either end touches a patch's line. The distance of x to the
+    // line is measured from the patch's nearer end (orient(p, q, x) is
+    // |q - p| times that distance; from q it is -orient(q, p, x)).
+    const auto magnitude = [](Vec2 v) { return std::max(std::abs(v.x), std::abs(v.y)); };
+    const auto on_line = [&](Vec2 p, Vec2 q, Vec2 x) {
+        const bool from_p = distance(x, p) <= distance(x, q);
+        const Vec2 near = from_p ? p : q;
+        const double o = from_p ? orient(p, q, x) : -orient(q, p, x);
+        const double local = std::max(magnitude(x), magnitude(near)) + distance(x, near);
+        return o <= on_edge_tolerance * local * distance(p, q);
+    };
     bool end_on_patch_line = false;
     for (size_t e : {size_t{0}, size_t{2}}) {
         const Vec2 p = shaft.v[e], q = shaft.v[e + 1];
-        const double orient_tol = tol * distance(p, q);
-        const bool a_on = orient(p, q, piece.a) <= orient_tol, b_on = orient(p, q, piece.b) <= orient_tol;
+        const bool a_on = on_line(p, q, piece.a), b_on = on_line(p, q, piece.b);
         if (a_on && b_on) return false;
         end_on_patch_line = end_on_patch_line || a_on || b_on;
     }
