@@ -62,7 +62,9 @@ int main(int argc, char** argv) {
                 const double err = std::abs(res.F - exact);
                 if (res.clusters_approximated > 0) {
                     ++y.approximating;
-                    const double ratio = res.error_bound > 0 ? err / res.error_bound : 0;
+                    // Error / bound is only meaningful above rounding.
+                    const double floor = rounding_floor * unoccluded;
+                    const double ratio = res.error_bound > floor ? err / res.error_bound : 0;
                     y.worst_ratio = std::max(y.worst_ratio, ratio);
                     y.sum_ratio += ratio;
                 }
