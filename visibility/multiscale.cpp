@@ -447,6 +447,21 @@ struct Interactions {
     long k_first = 0, k_last = -1;  // sample indices covering the range, widened
     std::vector<double> lo, hi;     // window per sample
     std::vector<std::vector<double>> starts, ends;  // sorted shadow ends per sample
+    std::vector<double> start_val, end_val;         // scratch for the current sample
+    std::vector<int32_t> start_order, end_order;
+
+    static void insertion_sort(std::vector<int32_t>& order, const std::vector<double>& v) {
+        for (size_t k = 1; k < order.size(); ++k) {
+            const int32_t key = order[k];
+            const double x = v[static_cast<size_t>(key)];
+            size_t r = k;
+            while (r > 0 && v[static_cast<size_t>(order[r - 1])] > x) {
+                order[r] = order[r - 1];
+                --r;
+            }
+            order[r] = key;
+        }
+    }
 
     static constexpr double pi = 3.14159265358979323846;
     static double step() { return pi / ClusterTables::directions; }
@@ -470,16 +485,36 @@ struct Interactions {
             const double c0 = nx * g.cj.a.x + ny * g.cj.a.y, c1 = nx * g.cj.b.x + ny * g.cj.b.y;
             lo[q] = std::max(std::min(a0, a1), std::min(c0, c1));
             hi[q] = std::min(std::max(a0, a1), std::max(c0, c1));
-            starts[q].resize(pieces.size());
-            ends[q].resize(pieces.size());
-            for (size_t b = 0; b < pieces.size(); ++b) {
+            // Shadow ends, sorted. Neighbouring samples are a fraction of a
+            // degree apart, so the previous sample's order is nearly right:
+            // keep the index orders and repair them by insertion sort.
+            const size_t m = pieces.size();
+            start_val.resize(m);
+            end_val.resize(m);
+            for (size_t b = 0; b < m; ++b) {
                 const double pa = nx * pieces[b].a.x + ny * pieces[b].a.y;
                 const double pb = nx * pieces[b].b.x + ny * pieces[b].b.y;
-                starts[q][b] = std::min(pa, pb);
-                ends[q][b] = std::max(pa, pb);
+                start_val[b] = std::min(pa, pb);
+                end_val[b] = std::max(pa, pb);
             }
-            std::sort(starts[q].begin(), starts[q].end());
-            std::sort(ends[q].begin(), ends[q].end());
+            if (q == 0) {  // first sample: a full sort
+                start_order.resize(m);
+                end_order.resize(m);
+                for (size_t b = 0; b < m; ++b) start_order[b] = end_order[b] = static_cast<int32_t>(b);
+                std::sort(start_order.begin(), start_order.end(),
+                          [&](int32_t x, int32_t y) { return start_val[static_cast<size_t>(x)] < start_val[static_cast<size_t>(y)]; });
+                std::sort(end_order.begin(), end_order.end(),
+                          [&](int32_t x, int32_t y) { return end_val[static_cast<size_t>(x)] < end_val[static_cast<size_t>(y)]; });
+            } else {
+                insertion_sort(start_order, start_val);
+                insertion_sort(end_order, end_val);
+            }
+            starts[q].resize(m);
+            ends[q].resize(m);
+            for (size_t b = 0; b < m; ++b) {
+                starts[q][b] = start_val[static_cast<size_t>(start_order[b])];
+                ends[q][b] = end_val[static_cast<size_t>(end_order[b])];
+            }
         }
     }
 
@@ -492,19 +527,16 @@ struct Interactions {
                              nx * box.hi.x + ny * box.hi.y, nx * box.lo.x + ny * box.hi.y};
         const double a = std::min({c[0], c[1], c[2], c[3]}), b = std::max({c[0], c[1], c[2], c[3]});
         if (a < lo[q] || b > hi[q]) return true;  // the window cuts C's shadow
-        // Pieces whose shadow meets (a, b): all minus those ending at or
-        // before a, minus those starting at or after b; then C's own.
+        // Pieces whose shadow meets [a, b] (closed: touching counts, which
+        // only errs on the safe side): all minus those ending before a,
+        // minus those starting after b. C's own pieces lie in its box, so
+        // all of them meet it; any more is another piece.
         const auto& st = starts[q];
         const auto& en = ends[q];
         const long meeting = static_cast<long>(st.size()) -
-                             static_cast<long>(std::upper_bound(en.begin(), en.end(), a) - en.begin()) -
-                             static_cast<long>(st.end() - std::lower_bound(st.begin(), st.end(), b));
-        long own = 0;
-        for (size_t k = own_lo; k < own_hi; ++k) {
-            const double pa = nx * pieces[k].a.x + ny * pieces[k].a.y, pb = nx * pieces[k].b.x + ny * pieces[k].b.y;
-            if (std::max(pa, pb) > a && std::min(pa, pb) < b) ++own;
-        }
-        return meeting > own;
+                             static_cast<long>(std::lower_bound(en.begin(), en.end(), a) - en.begin()) -
+                             static_cast<long>(st.end() - std::upper_bound(st.begin(), st.end(), b));
+        return meeting > static_cast<long>(own_hi - own_lo);
     }
 
     double bound(const ClusterTables& tables, int node, const Box& box, size_t own_lo, size_t own_hi) const {

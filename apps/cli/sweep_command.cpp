@@ -1,6 +1,5 @@
 #include "cli/sweep_command.h"
 
-#include <omp.h>
 
 #include <algorithm>
 #include <charconv>
@@ -32,31 +31,6 @@ const char* const orange = "#ff7f0e";
 const char* const red = "#d62728";
 const char* const grey = "#7f7f7f";
 
-// FormFactorContext::compute shares A's patches among OpenMP threads, so
-// threads beyond A's patch count have nothing to do but join; on a loaded
-// machine that join waits for the idle thread to be scheduled, which was
-// measured at 4-16 ms on a 0.5 ms query (one patch in A, two threads). The
-// sweep therefore runs with at most one thread per patch of A, and puts
-// the previous setting back afterwards.
-class ThreadCap {
-public:
-    explicit ThreadCap(int patches) : m_previous(omp_get_max_threads()) {
-        omp_set_num_threads(std::clamp(patches, 1, m_previous));
-    }
-    ~ThreadCap() { omp_set_num_threads(m_previous); }
-    ThreadCap(const ThreadCap&) = delete;
-    ThreadCap& operator=(const ThreadCap&) = delete;
-
-private:
-    int m_previous;
-};
-
-int patches_of(const Scene& scene, const std::vector<int>& surfaces) {
-    int n = 0;
-    for (const auto& patch : scene.patches)
-        if (std::find(surfaces.begin(), surfaces.end(), patch.surface) != surfaces.end()) ++n;
-    return n;
-}
 
 double median(std::vector<double> v) {
     std::sort(v.begin(), v.end());
@@ -289,7 +263,6 @@ Sweep run_form_factor_sweep(const FormFactorContext& context, const std::vector<
     Sweep s;
     s.rule = rule;
     s.repeat = std::max(1, repeat);
-    const ThreadCap threads(patches_of(context.scene(), from));
 
     // 1. The exact value, timed.
     std::vector<double> times;
