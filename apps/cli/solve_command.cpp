@@ -11,6 +11,7 @@
 #include "cli/usage_error.h"
 #include "engine/scene.h"
 #include "solver/exact_solver.h"
+#include "solver/hierarchical_solver.h"
 
 namespace flatrad {
 
@@ -22,11 +23,7 @@ void check_tolerance(const std::optional<double>& value, const char* flag) {
 }
 
 void check_arguments(const SolveArgs& args) {
-    if (args.method == "hierarchical")
-        throw UsageError(
-            "--method hierarchical: not available yet (the hierarchical solver has not landed); "
-            "use --method exact");
-    if (args.method != "exact")
+    if (args.method != "exact" && args.method != "hierarchical")
         throw UsageError(fmt::format("--method {}: expected exact or hierarchical", args.method));
     if (!args.svg.empty())
         throw UsageError("--svg: not available yet (the SVG writer has not landed)");
@@ -37,20 +34,9 @@ void check_arguments(const SolveArgs& args) {
                                      args.threads));
     check_tolerance(args.eps, "--eps");
     check_tolerance(args.vis_eps, "--vis-eps");
+    if (args.method == "hierarchical" && args.eps && *args.eps == 0)
+        throw UsageError("--eps: --method hierarchical needs a tolerance > 0 (0 would refine forever)");
     if (!args.output.empty()) check_output_path(args.output, "-o");
-}
-
-// The exact solver holds a dense elements x elements matrix of doubles.
-void check_exact_size(const Scene& scene, int subdivide) {
-    const double patches = static_cast<double>(scene.patches.size());
-    const double elements = patches * subdivide;
-    const double bytes = elements * elements * 8;
-    if (bytes > exact_matrix_limit_bytes)
-        throw UsageError(fmt::format(
-            "--subdivide {}: {:.0f} elements ({} patches x {}) would need {:.1f} GiB for the "
-            "exact solver's form-factor matrix (elements^2 x 8 bytes); the limit is {:.0f} GiB",
-            subdivide, elements, scene.patches.size(), subdivide, bytes / (1024.0 * 1024 * 1024),
-            exact_matrix_limit_bytes / (1024.0 * 1024 * 1024)));
 }
 
 }  // namespace
@@ -58,12 +44,23 @@ void check_exact_size(const Scene& scene, int subdivide) {
 int run_solve(const SolveArgs& args, std::ostream& out, std::ostream& err) {
     check_arguments(args);
     const Scene scene = load_scene(args.scene);
-    check_exact_size(scene, args.subdivide);
+    Solution solution;
+    if (args.method == "hierarchical") {
+        HierarchicalOptions options;
+        if (args.eps) options.eps = *args.eps;
+        if (args.vis_eps) options.vis_eps = *args.vis_eps;
+        options.threads = args.threads;
+        solution = solve_hierarchical(scene, options);
+    } else {
+        // Refused before any work when it would not fit (the message says how
+        // much it would need); the flag is named when --subdivide is the cause.
+        check_exact_solver_memory(scene, args.subdivide);
 
-    ExactSolverOptions options;
-    options.subdivide = args.subdivide;
-    options.threads = args.threads;
-    const Solution solution = solve_exact(scene, options);
+        ExactSolverOptions options;
+        options.subdivide = args.subdivide;
+        options.threads = args.threads;
+        solution = solve_exact(scene, options);
+    }
 
     const std::string text = format_result(result_json(scene, solution));
     if (args.output.empty()) {

@@ -160,15 +160,28 @@ TEST_CASE("cli: bad arguments give status 2 and one error line") {
     }
 }
 
+TEST_CASE("cli: solve --method hierarchical runs and records its tolerances") {
+    TempDir tmp;
+    const std::string scene = tmp.file("plates.json", two_plates);
+    const Run h = run({"solve", scene, "--method", "hierarchical", "--eps", "0.001", "--vis-eps", "0.0001",
+                       "--quiet"});
+    CHECK(h.status == 0);
+    CHECK(h.err.empty());
+    const json result = json::parse(h.out);
+    CHECK(result["method"] == "hierarchical");
+    CHECK(result["settings"]["eps"] == 0.001);
+    CHECK(result["settings"]["vis_eps"] == 0.0001);
+    CHECK(result["patches"].size() > 0);
+    CHECK(result["stats"]["elements"].get<long>() >= static_cast<long>(result["patches"].size()));
+
+    const Run zero = run({"solve", scene, "--method", "hierarchical", "--eps", "0"});
+    CHECK(zero.status == 2);
+    CHECK(is_one_error_line(zero.err));
+}
+
 TEST_CASE("cli: methods and commands that have not landed say so") {
     TempDir tmp;
     const std::string scene = tmp.file("plates.json", two_plates);
-
-    const Run h = run({"solve", scene, "--method", "hierarchical"});
-    CHECK(h.status == 2);
-    CHECK(h.err ==
-          "error: --method hierarchical: not available yet (the hierarchical solver has not "
-          "landed); use --method exact\n");
 
     for (const auto& args : std::vector<std::vector<std::string>>{
              {"solve", scene, "--svg", tmp.path("x.svg")},

@@ -1,0 +1,146 @@
+// The hierarchical solver without clustering (solver/hierarchical_solver.h):
+// white furnace, convergence to the exact solver as eps shrinks, energy
+// balance, refusal of a closed reflectance-1 room.
+#include "solver/hierarchical_solver.h"
+
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <fmt/format.h>
+#include <string>
+
+#include "engine/error.h"
+#include "solver/exact_solver.h"
+
+using namespace flatrad;
+
+namespace {
+
+// A closed room with an occluding two-sided plate and an "out" pillar, one
+// material everywhere (the exact solver's furnace).
+std::string furnace_scene(double rho, double emission) {
+    return fmt::format(R"({{"flatrad": 1, "name": "furnace",
+      "materials": {{"m": {{"reflectance": {}, "emission": {}}}}},
+      "surfaces": [
+        {{"name": "room", "material": "m", "closed": true, "side": "in",
+          "points": [[0,0],[2,0],[2,1],[1.4,1.3],[0,1]]}},
+        {{"name": "plate", "material": "m", "points": [[0.3,0.4],[0.9,0.7]], "side": "both"}},
+        {{"name": "pillar", "material": "m", "circle": {{"center": [1.5, 0.5], "radius": 0.2, "segments": 16}}, "side": "out"}}
+      ]}})",
+                       rho, emission);
+}
+
+// Open: a lamp over a floor with a one-sided blocker between (its unlit side a sink).
+const char* open_plates = R"({"flatrad": 1, "name": "open plates",
+  "materials": {"lamp": {"reflectance": 0.2, "emission": 5}, "grey": {"reflectance": 0.6}},
+  "surfaces": [
+    {"name": "floor", "material": "grey", "points": [[0,0],[3,0]]},
+    {"name": "lamp", "material": "lamp", "points": [[2,2],[0.5,2.2]]},
+    {"name": "blocker", "material": "grey", "points": [[1.2,1],[1.8,1.1]], "side": "right"}
+  ]})";
+
+// Closed box lit by a small lamp, a two-sided shelf casting shadows.
+const char* shadow_box = R"({"flatrad": 1, "name": "shadow box",
+  "materials": {"white": {"reflectance": 0.7}, "lamp": {"emission": 10},
+                "dark": {"reflectance": [0.3]}},
+  "surfaces": [
+    {"name": "room", "material": "white", "closed": true, "side": "in",
+     "points": [[0,0],[3,0],[3,2],[0,2]]},
+    {"name": "lamp", "material": "lamp", "points": [[1.2,1.95],[1.8,1.95]], "side": "right"},
+    {"name": "shelf", "material": "dark", "points": [[0.8,1.0],[2.0,1.2]], "side": "both"}
+  ]})";
+
+// Relative L2 error of per-patch radiosity, length-weighted over all channels.
+double relative_l2(const Scene& scene, const Solution& h, const Solution& e) {
+    double num = 0, den = 0;
+    for (size_t p = 0; p < scene.patches.size(); ++p)
+        for (int c = 0; c < scene.channels; ++c) {
+            const double L = scene.patches[p].length;
+            const double d = h.patches[p].radiosity[static_cast<size_t>(c)] - e.patches[p].radiosity[static_cast<size_t>(c)];
+            num += L * d * d;
+            den += L * e.patches[p].radiosity[static_cast<size_t>(c)] * e.patches[p].radiosity[static_cast<size_t>(c)];
+        }
+    return std::sqrt(num / den);
+}
+
+}  // namespace
+
+TEST_CASE("hierarchical solver: white furnace at reflectance 0.999 gives E / (1 - rho)") {
+    // A leaf's row sum off by d moves B by about d / (1 - rho) = 1000 d
+    // here: this holds only because closed patches' leaves get their row
+    // deficit (the header's "Row sums"), with approximated visibility too.
+    constexpr double furnace_tol = 1e-6;  // the issue's bar
+    const Scene scene = parse_scene(furnace_scene(0.999, 1.0), "furnace.json");
+    for (double vis_eps : {-1.0, 0.0, 1e-3, 1e-5}) {  // -1: the default, eps / 10
+        CAPTURE(vis_eps);
+        HierarchicalOptions o;
+        o.eps = 1e-2;
+        o.vis_eps = vis_eps;
+        const Solution sol = solve_hierarchical(scene, o);
+        double worst = 0;
+        for (const PatchResult& p : sol.patches) {
+            worst = std::max(worst, std::abs(p.radiosity[0] - 1000.0) / 1000.0);
+            for (const ElementValue& e : p.elements) worst = std::max(worst, std::abs(e.B[0] - 1000.0) / 1000.0);
+        }
+        MESSAGE(fmt::format("furnace vis_eps {:g}: worst {:.3g}, iterations {}, elements {}, links {}, "
+                            "approximated {}", sol.vis_eps, worst, sol.stats.iterations, sol.stats.elements,
+                            sol.stats.links, sol.stats.visibility.approximated));
+        CHECK(sol.method == "hierarchical");
+        CHECK(worst <= furnace_tol);
+        CHECK(sol.stats.iterations <= 100);
+        CHECK(sol.stats.visibility.queries > 0);  // the plate and pillar really occlude
+        CHECK(sol.totals.balance[0] <= 1e-9);
+    }
+}
+
+TEST_CASE("hierarchical solver: reflectance 1 in a closed room is refused, 0.999999 is solved") {
+    const Scene white = parse_scene(furnace_scene(1.0, 1.0), "white.json");
+    CHECK_THROWS_AS(solve_hierarchical(white), InputError);
+    const Scene almost = parse_scene(furnace_scene(0.999999, 1.0), "almost.json");
+    CHECK_NOTHROW(solve_hierarchical(almost));
+}
+
+TEST_CASE("hierarchical solver: converges to the exact solver as eps shrinks") {
+    constexpr double tight_tol = 1e-3;    // the issue's bar at eps = 1e-3
+    constexpr double balance_tol = 1e-4;  // the issue's bar at eps = 1e-3
+    constexpr int reference_subdivide = 48;
+    struct Case {
+        std::string name;
+        Scene scene;
+    };
+    std::vector<Case> cases;
+    cases.push_back({"default", load_scene(FLATRAD_DATA_DIR "/default.json")});
+    cases.push_back({"open plates", parse_scene(open_plates, "open.json")});
+    cases.push_back({"shadow box", parse_scene(shadow_box, "shadow.json")});
+    for (const Case& k : cases) {
+        CAPTURE(k.name);
+        // K = 48, not 16: on data/default.json the K = 16 mesh is itself
+        // 1.2e-3 (relative L2) from K = 48, as far off as the bar below.
+        const Solution exact = solve_exact(k.scene, {reference_subdivide, 0});
+        double prev = 1e300;
+        for (double eps : {1e-1, 1e-2, 1e-3}) {
+            HierarchicalOptions o;
+            o.eps = eps;
+            const Solution h = solve_hierarchical(k.scene, o);
+            const double err = relative_l2(k.scene, h, exact);
+            double balance = 0, absorbed_err = 0;
+            for (double b : h.totals.balance) balance = std::max(balance, b);
+            // Not a bar: balance above only measures the linear solve; this is
+            // the absorbed power's error against the exact solver's.
+            for (int c = 0; c < k.scene.channels; ++c)
+                absorbed_err = std::max(absorbed_err, std::abs(h.totals.absorbed[static_cast<size_t>(c)] -
+                                                               exact.totals.absorbed[static_cast<size_t>(c)]) /
+                                                          exact.totals.emitted[static_cast<size_t>(c)]);
+            MESSAGE(fmt::format("{}: eps {:g}: L2 {:.3e}, balance {:.2e}, absorbed err {:.2e}, elements {}, links {}, iterations {}, "
+                                "time {:.3f}s (exact K=48: {:.3f}s)",
+                                k.name, eps, err, balance, absorbed_err, h.stats.elements, h.stats.links, h.stats.iterations,
+                                h.stats.time_s, exact.stats.time_s));
+            CHECK(err < prev);
+            prev = err;
+            if (eps == 1e-3) {
+                CHECK(err <= tight_tol);
+                CHECK(balance <= balance_tol);
+            }
+        }
+    }
+}
