@@ -577,6 +577,12 @@ const char* gamma_rule_name(GammaRule r) {
     return "?";
 }
 
+std::optional<GammaRule> gamma_rule_from_name(const std::string& name) {
+    for (GammaRule r : {GammaRule::Bound, GammaRule::BoundUniform, GammaRule::Paper, GammaRule::LineSpace})
+        if (name == gamma_rule_name(r)) return r;
+    return std::nullopt;
+}
+
 MultiscaleVisibility::MultiscaleVisibility(const Hierarchy& hierarchy, const ClusterTables& tables)
     : m_hierarchy(&hierarchy), m_tables(&tables) {
     m_position.assign(hierarchy.segments().size(), -1);

@@ -19,6 +19,9 @@
 /// Errors of several approximated clusters add up (for factors in [0, 1],
 /// |prod a - prod b| <= sum |a - b|), so the claimed bound is the sum of the
 /// criteria used. Each cluster is tested against eps alone, as in the paper.
+#include <optional>
+#include <string>
+
 #include "visibility/cluster_tables.h"
 #include "visibility/exact_visibility.h"
 
@@ -46,6 +49,8 @@ enum class GammaRule {
 };
 
 const char* gamma_rule_name(GammaRule r);
+/// The rule called `name` (as gamma_rule_name writes it), if any.
+std::optional<GammaRule> gamma_rule_from_name(const std::string& name);
 
 /// The three criteria of one cluster for one pair (for experiments).
 struct ClusterCriteria {

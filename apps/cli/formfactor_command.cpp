@@ -71,14 +71,10 @@ int run_formfactor(const FormFactorArgs& args, std::ostream& out, std::ostream& 
     const std::vector<int> to = surface_group(scene, args.to, "--to");
     GroupFormFactorOptions options;
     options.eps = method == FormFactorMethod::Multiscale ? args.eps.value_or(default_multiscale_eps) : 0.0;
-    if (args.gamma == "paper")
-        options.rule = GammaRule::Paper;
-    else if (args.gamma == "line-space")
-        options.rule = GammaRule::LineSpace;
-    else if (args.gamma == "bound")
-        options.rule = GammaRule::Bound;
+    if (const auto rule = gamma_rule_from_name(args.gamma))
+        options.rule = *rule;
     else
-        throw UsageError(fmt::format("--gamma {}: expected bound, paper or line-space", args.gamma));
+        throw UsageError(fmt::format("--gamma {}: expected bound, bound-uniform, paper or line-space", args.gamma));
     const GroupFormFactor result = group_form_factor(scene, from, to, method, options);
 
     nlohmann::ordered_json j;

@@ -39,10 +39,8 @@ double median(std::vector<double> v) {
 }
 
 GammaRule parse_gamma(const std::string& name) {
-    if (name == "bound") return GammaRule::Bound;
-    if (name == "paper") return GammaRule::Paper;
-    if (name == "line-space") return GammaRule::LineSpace;
-    throw UsageError(fmt::format("--gamma {}: expected bound, paper or line-space", name));
+    if (const auto r = gamma_rule_from_name(name)) return *r;
+    throw UsageError(fmt::format("--gamma {}: expected bound, bound-uniform, paper or line-space", name));
 }
 
 // A number that must fill the whole field (no trailing junk, no spaces).
@@ -374,7 +372,7 @@ CLI::App* add_sweep_command(CLI::App& app, SweepArgs& a) {
                     "Multiscale criterion: bound (rigorous L1 line-space bound, the default), paper "
                     "(Soler 1995's Gamma as written) or line-space (DESIGN's L2 variant).")
         ->type_name("RULE")
-        ->check(CLI::IsMember({"bound", "paper", "line-space"}))
+        ->check(CLI::IsMember({"bound", "bound-uniform", "paper", "line-space"}))
         ->capture_default_str();
     cmd->add_option("--repeat", a.repeat, "Runs per point, >= 1; times are medians.")
         ->type_name("R")
