@@ -686,7 +686,7 @@ MultiscaleResult MultiscaleVisibility::form_factor_skipping(const Segment& i, co
     if (!separated) {
         // 1b. Decide, top down: approximate a cluster wholly inside the shaft
         //     whose criterion is below eps; the pieces of the rest are exact.
-        const Interactions inter(g, pieces, piece_pos, eps > 0 && rule == GammaRule::Bound);
+        const Interactions inter(g, pieces, piece_pos, eps > 0 && rule == GammaRule::Bound && !pieces.empty());
         stack.push_back(m_hierarchy->root());
         while (!stack.empty()) {
             const int k = stack.back();
