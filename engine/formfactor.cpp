@@ -32,9 +32,12 @@ std::optional<Segment> clip_left(const Segment& s, Vec2 p, Vec2 q) {
         return s;
     }
     if (oa <= 0 && ob <= 0) return std::nullopt;
-    // One endpoint strictly on each side: cut at the crossing.
+    // One endpoint strictly on each side: cut at the crossing, measured
+    // from the nearer end (its rounding is then a few ulps of that
+    // distance, not of the whole length: a cut 8 from the end of a 5e14
+    // wall stays within 1e-15 instead of 0.1).
     const double t = oa / (oa - ob);
-    const Vec2 x = lerp(s.a, s.b, t);
+    const Vec2 x = t <= 0.5 ? lerp(s.a, s.b, t) : lerp(s.b, s.a, ob / (ob - oa));
     return oa > 0 ? Segment{s.a, x} : Segment{x, s.b};
 }
 
@@ -80,12 +83,24 @@ std::optional<std::pair<Segment, Segment>> clip_to_lit_halfplanes(const Segment&
     // When the two lines cross inside both segments, each is cut at the
     // crossing, computed twice with different roundings. Make the two cuts
     // one point, so that the pair is an exact wedge (and the shaft has no
-    // sliver of an edge whose orientation is rounding noise).
-    const double snap = snap_tolerance * (std::max({std::abs(i.a.x), std::abs(i.a.y), std::abs(i.b.x), std::abs(i.b.y),
-                                                    std::abs(j.a.x), std::abs(j.a.y), std::abs(j.b.x), std::abs(j.b.y)}) +
-                                          i.length() + j.length());
-    if (!(ci->a == cj->b) && distance(ci->a, cj->b) <= snap) cj->b = ci->a;
-    if (!(ci->b == cj->a) && distance(ci->b, cj->a) <= snap) cj->a = ci->b;
+    // sliver of an edge whose orientation is rounding noise). Only a cut
+    // point carries that rounding, and only of its own size: two uncut
+    // endpoints are never moved (a 1e57-long wall must not pull the end of
+    // a unit lamp 2 away onto its corner).
+    // A cut point's rounding: a few ulps of its coordinates and of its
+    // distance to the end of its segment it was measured from (clip_left).
+    const auto scale = [](Vec2 x, const Segment& s) {
+        return std::max(std::abs(x.x), std::abs(x.y)) + std::min(distance(x, s.a), distance(x, s.b));
+    };
+    const auto snaps = [&](Vec2 p, bool p_cut, const Segment& p_from, Vec2 q, bool q_cut, const Segment& q_from) {
+        if (p == q || !(p_cut || q_cut)) return false;
+        const double snap = snap_tolerance * ((p_cut ? scale(p, p_from) : 0.0) + (q_cut ? scale(q, q_from) : 0.0));
+        return distance(p, q) <= snap;
+    };
+    const bool ia_cut = !(ci->a == i.a), ib_cut = !(ci->b == i.b);
+    const bool ja_cut = !(cj->a == j.a), jb_cut = !(cj->b == j.b);
+    if (snaps(ci->a, ia_cut, i, cj->b, jb_cut, j)) cj->b = ci->a;
+    if (snaps(ci->b, ib_cut, i, cj->a, ja_cut, j)) cj->a = ci->b;
     if (ci->a == ci->b || cj->a == cj->b) return std::nullopt;
     return std::make_pair(*ci, *cj);
 }
@@ -95,6 +110,11 @@ double exchange_crossed_strings(const Segment& i, const Segment& j) {
     // g = d - c:
     //   S = [2 (g.(a - b)) s_b + (g.(2b - c - d)) (s_b - s_a)] / (s_a s_b),
     //   s_b - s_a = (|b - c| - |a - c|) + (|b - d| - |a - d|), each paired.
+    // The form below subtracts nearby values only when i is the shorter
+    // segment (its error is a few ulps of L_i, not of X): the exchange is
+    // symmetric, so let the shorter one play i. Beside a 1e33-long wall a
+    // unit segment's X would otherwise be noise of size 1e17.
+    if (norm_squared(i.b - i.a) > norm_squared(j.b - j.a)) return exchange_crossed_strings(j, i);
     const Vec2 a = i.a, b = i.b, c = j.a, d = j.b;
     if (b == c) return exchange_wedge(b, a, d);
     if (a == d) return exchange_wedge(a, b, c);

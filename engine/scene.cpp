@@ -20,6 +20,7 @@
 #include <nlohmann/json.hpp>
 
 #include "engine/error.h"
+#include "engine/hierarchy.h"
 
 namespace flatrad {
 
@@ -47,6 +48,14 @@ int Scene::find_surface(const std::string& surface_name) const {
     return -1;
 }
 
+double scene_memory_bytes(double segments) {
+    // Per segment: the segment, two patches, its point, and in the cluster
+    // hierarchy a copy of the segment, its order entry and about one node.
+    constexpr double per_segment = sizeof(SceneSegment) + 2 * sizeof(Patch) + sizeof(Vec2) + sizeof(Segment) +
+                                   sizeof(int32_t) + sizeof(ClusterNode);
+    return segments * per_segment;
+}
+
 double Scene::extent() const {
     Box box;
     for (const Surface& s : surfaces)
@@ -64,6 +73,15 @@ using Json = nlohmann::ordered_json;
 /// far from overflow (1e200 << 1.8e308), above it a legal-looking scene would
 /// turn into infinities inside the kernels.
 constexpr double max_coordinate = 1e100;
+
+/// Largest ratio of the scene's extent (bounding-box diagonal) to its
+/// shortest segment. The exact path keeps every answer to rounding up to
+/// 1e16 (tests/solver/extremes_test.cpp: a 1e-8 segment beside a 1e8 one);
+/// beyond about 1e17 the two sides of a sliver wedge (a 1e17-long wall
+/// meeting another across a unit gap) span directions no double can tell
+/// from a half turn, and small segments inside it are lost to rounding. So
+/// the range is capped at 2e16, with a clear refusal.
+constexpr double max_length_range = 2e16;
 
 /// A circle's segment count is bounded so that a typo (1e9) is refused rather
 /// than exhausting memory; a million segments is far finer than any solver
@@ -361,6 +379,7 @@ private:
         if (!surfaces.is_array())
             fail("surfaces", fmt::format("expected an array of surfaces, found {}", describe(surfaces)));
         if (surfaces.empty()) fail("surfaces", "a scene needs at least one surface, found an empty array");
+        check_memory(surfaces);
 
         std::unordered_map<std::string, size_t> material_index;
         for (size_t m = 0; m < scene.materials.size(); ++m) material_index.emplace(scene.materials[m].name, m);
@@ -426,6 +445,61 @@ private:
             add_segments_and_patches(surface, static_cast<int>(i), counter_clockwise, scene);
             scene.surfaces.push_back(std::move(surface));
         }
+        check_length_range(scene);
+    }
+
+    /// Refuses, before anything is built, a scene whose segments would
+    /// need more memory than scene_memory_limit_bytes, at the surface that
+    /// takes it over, saying how much. Counts what each surface asks for
+    /// (points, or a circle's segments); malformed entries count 0 here and
+    /// are refused by the full reading that follows.
+    void check_memory(const Json& surfaces) const {
+        double total = 0;
+        for (size_t i = 0; i < surfaces.size(); ++i) {
+            const Json& s = surfaces[i];
+            if (!s.is_object()) continue;
+            double count = 0;
+            std::string where = index_path("surfaces", i);
+            if (const Json* points = optional(s, "points"); points && points->is_array()) {
+                count = static_cast<double>(points->size());
+                where = key_path(where, "points");
+            } else if (const Json* circle = optional(s, "circle"); circle && circle->is_object()) {
+                const Json* n = optional(*circle, "segments");
+                if (n && n->is_number() && std::isfinite(n->get<double>()))
+                    count = std::clamp(n->get<double>(), 0.0, max_circle_segments);
+                where = key_path(key_path(where, "circle"), "segments");
+            }
+            total += count;
+            const double bytes = scene_memory_bytes(total);
+            if (bytes > scene_memory_limit_bytes) {
+                constexpr double gib = 1024.0 * 1024 * 1024;
+                fail(where, fmt::format("the scene would have {:.0f} segments by this surface, which would need "
+                                        "{:.1f} GiB to hold; the limit is {:.0f} GiB (use fewer or coarser "
+                                        "surfaces)",
+                                        total, bytes / gib, scene_memory_limit_bytes / gib));
+            }
+        }
+    }
+
+    /// Refuses a scene whose shortest segment is below 1 / max_length_range
+    /// of its extent, naming that segment.
+    void check_length_range(const Scene& scene) const {
+        size_t shortest = 0;
+        for (size_t k = 1; k < scene.segments.size(); ++k)
+            if (scene.segments[k].seg.length() < scene.segments[shortest].seg.length()) shortest = k;
+        const double length = scene.segments[shortest].seg.length(), extent = scene.extent();
+        if (extent <= max_length_range * length) return;
+        const SceneSegment& s = scene.segments[shortest];
+        const Surface& surface = scene.surfaces[static_cast<size_t>(s.surface)];
+        const std::string base = index_path("surfaces", static_cast<size_t>(s.surface));
+        const std::string where =
+            surface.is_circle ? key_path(base, "circle")
+                              : index_path(key_path(base, "points"),
+                                           static_cast<size_t>(s.index + 1) % surface.points.size());
+        fail(where, fmt::format("segment {} is {:g} long, {:.2g} times shorter than the scene's extent {:g}: "
+                                "beyond the {:g} range of lengths that double precision resolves here (make it "
+                                "longer, or the scene smaller)",
+                                s.index, length, extent / length, extent, max_length_range));
     }
 
     static std::string known_materials(const Scene& scene) {

@@ -78,8 +78,21 @@ struct Scene {
     double extent() const;
 };
 
+/// Most memory a scene may take to hold: its segments, its patches (two
+/// per segment at most) and the cluster hierarchy built over them. 1 GiB,
+/// about 4 million segments: far beyond what the exact solver can use
+/// (exact_solver.h) and still a small part of a 24 GiB machine. A file
+/// asking for more (a few circles of a million segments take a few
+/// hundred bytes of JSON) is refused while being read, before it is built.
+constexpr double scene_memory_limit_bytes = 1024.0 * 1024 * 1024;
+
+/// Estimated bytes to hold a scene of `segments` segments (the worst case
+/// of two patches each) and its cluster hierarchy.
+double scene_memory_bytes(double segments);
+
 /// Reads and validates a scene file (SPEC.md, "Scene file").
-/// Throws InputError(file, json_path, message) on any fault SPEC.md lists;
+/// Throws InputError(file, json_path, message) on any fault SPEC.md lists,
+/// and when the scene would need more than scene_memory_limit_bytes;
 /// `file` in the error is `path` as given.
 Scene load_scene(const std::string& path);
 

@@ -66,6 +66,7 @@ Solution solve_exact(const Scene& scene, const ExactSolverOptions& options) {
     const auto t_start = Clock::now();
     const int K = options.subdivide;
     if (K < 1) throw InputError(scene.file, "--subdivide", fmt::format("expected an integer >= 1, found {}", K));
+    check_exact_solver_memory(scene, K);
     const int threads = options.threads > 0 ? options.threads : omp_get_max_threads();
     const int C = scene.channels;
 

@@ -13,9 +13,31 @@ struct ExactSolverOptions {
     int threads = 0;     ///< 0: all cores
 };
 
+/// Most memory the exact solver may plan to use: 8 GiB, a third of this
+/// project's 24 GiB machines, so that a run beyond it is refused up front
+/// instead of swapping or being killed by the kernel half-way.
+constexpr double exact_solver_memory_limit_bytes = 8.0 * 1024 * 1024 * 1024;
+
+/// Estimated peak memory of solve_exact(scene, {K}), in bytes: n = patches
+/// x K elements, three dense n x n double matrices alive at once (the form
+/// factors F, the system I - rho F, and its LU factors) = 3 n^2 x 8, plus
+/// the per-element arrays (elements, sinks, B, F B: O(n), small beside it).
+/// A double because absurd K overflow any integer type; exact to well
+/// under a byte in the range that matters (below 2^53).
+/// Pre: K >= 1.
+double exact_solver_memory_bytes(const Scene& scene, int K);
+
+/// Throws InputError (file: the scene's; path: "--subdivide" when K > 1,
+/// else none) when exact_solver_memory_bytes(scene, K) exceeds
+/// exact_solver_memory_limit_bytes, saying how much the run would need.
+/// solve_exact calls it first; callers may call it earlier (before other
+/// work, as the CLI does).
+void check_exact_solver_memory(const Scene& scene, int K);
+
 /// Throws InputError when the system has no unique solution (a closed
 /// enclosure of reflectance 1 without absorber, in some channel), naming
-/// the surfaces involved.
+/// the surfaces involved, and, before any work, when the run would need
+/// more memory than the limit (check_exact_solver_memory).
 Solution solve_exact(const Scene& scene, const ExactSolverOptions& options = {});
 
 }  // namespace flatrad

@@ -9,7 +9,10 @@ namespace flatrad {
 /// `PATH.tmp.<pid>`, renamed over `path` once complete (rename is atomic
 /// within a file system, so a reader sees the old file or the whole new
 /// one). On any failure the temporary file is removed, `path` is left as it
-/// was, and std::runtime_error says what failed and why.
+/// was, and std::runtime_error says what failed and why. SIGINT, SIGTERM
+/// or SIGHUP during the write remove the temporary file too, then take
+/// their previous course (by default: the process ends). Not thread-safe:
+/// one write at a time per process.
 void write_file_atomically(const std::filesystem::path& path, const std::string& text);
 
 /// Throws UsageError unless `path` could be created: its directory exists

@@ -7,6 +7,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "cli/compare_command.h"
 #include "cli/formfactor_command.h"
 #include "cli/solve_command.h"
 #include "cli/sweep_command.h"
@@ -54,6 +55,7 @@ struct Commands {
     CLI::App* compare_cmd = nullptr;
     CLI::App* sweep_cmd = nullptr;
     SweepArgs sweep;
+    CompareArgs compare;
 };
 
 void add_solve(CLI::App& app, Commands& c) {
@@ -92,7 +94,9 @@ void add_solve(CLI::App& app, Commands& c) {
                     "3 x (patches x K)^2 x 8 bytes; more than 8 GiB is refused up front.")
         ->type_name("K")
         ->capture_default_str();
-    cmd->add_option("--svg", a.svg, "Draw the solution as an SVG picture (not available yet).")
+    cmd->add_option("--svg", a.svg,
+                    "Draw the solution as an SVG picture (cli/scene_svg.h): each element colored by "
+                    "its radiosity on its lit side, unlit sides grey; written atomically.")
         ->type_name("OUT.svg");
     cmd->add_option("--threads", a.threads, "Threads for the form factors; 0: all cores.")
         ->type_name("N")
@@ -134,20 +138,17 @@ void add_formfactor(CLI::App& app, Commands& c) {
         "gives the exact value. Default 1e-3. Ignored by exact and unoccluded (reported as 0).")
                               ->type_name("E");
     cmd->add_option("--gamma", a.gamma,
-                    "Criterion of --method multiscale: bound (rigorous L1 line-space bound, the "
-                    "default), paper (Soler 1995's Gamma as written) or line-space (DESIGN's L2 variant).")
+                    "Criterion of --method multiscale: bound (line-space L1 bound charging only the "
+                    "directions where the cluster interacts, the default), bound-uniform (the same "
+                    "charging every direction), paper (Soler 1995's Gamma as written) or line-space "
+                    "(DESIGN's L2 variant).")
         ->type_name("RULE")
-        ->check(CLI::IsMember({"bound", "paper", "line-space"}))
+        ->check(CLI::IsMember({"bound", "bound-uniform", "paper", "line-space"}))
         ->capture_default_str();
 }
 
 void add_not_yet(CLI::App& app, Commands& c) {
-    c.compare_cmd = app.add_subcommand(
-        "compare", "Hierarchical against exact: error and run time (not available yet).");
-    c.compare_cmd->footer(
-        "Planned: flatrad compare SCENE [--eps E ...]. Not available yet: it needs the "
-        "hierarchical solver. Any arguments are accepted and the command exits with status 2.");
-    c.compare_cmd->allow_extras();
+    c.compare_cmd = add_compare_command(app, c.compare);  // cli/compare_command.h
     c.sweep_cmd = add_sweep_command(app, c.sweep);  // cli/sweep_command.h
 }
 
@@ -161,8 +162,7 @@ int dispatch(Commands& c, std::ostream& out, std::ostream& err) {
         if (c.formfactor_eps->count() > 0) c.formfactor.eps = c.ff_eps_value;
         return run_formfactor(c.formfactor, out, err);
     }
-    if (c.compare_cmd->parsed())
-        throw UsageError("compare: not available yet (the hierarchical solver has not landed)");
+    if (c.compare_cmd->parsed()) return run_compare(c.compare, out, err);
     if (c.sweep_cmd->parsed()) return run_sweep(c.sweep, out, err);
     throw UsageError("a command is required: solve, formfactor, compare or sweep (see flatrad --help)");
 }

@@ -7,6 +7,7 @@
 
 #include "cli/atomic_write.h"
 #include "cli/result_json.h"
+#include "cli/scene_svg.h"
 #include "cli/summary.h"
 #include "cli/usage_error.h"
 #include "engine/scene.h"
@@ -25,8 +26,6 @@ void check_tolerance(const std::optional<double>& value, const char* flag) {
 void check_arguments(const SolveArgs& args) {
     if (args.method != "exact" && args.method != "hierarchical")
         throw UsageError(fmt::format("--method {}: expected exact or hierarchical", args.method));
-    if (!args.svg.empty())
-        throw UsageError("--svg: not available yet (the SVG writer has not landed)");
     if (args.subdivide < 1)
         throw UsageError(fmt::format("--subdivide: expected an integer >= 1, got {}", args.subdivide));
     if (args.threads < 0)
@@ -37,6 +36,7 @@ void check_arguments(const SolveArgs& args) {
     if (args.method == "hierarchical" && args.eps && *args.eps == 0)
         throw UsageError("--eps: --method hierarchical needs a tolerance > 0 (0 would refine forever)");
     if (!args.output.empty()) check_output_path(args.output, "-o");
+    if (!args.svg.empty()) check_output_path(args.svg, "--svg");
 }
 
 }  // namespace
@@ -63,11 +63,14 @@ int run_solve(const SolveArgs& args, std::ostream& out, std::ostream& err) {
     }
 
     const std::string text = format_result(result_json(scene, solution));
+    // Drawn before anything is written, so that a failure writes nothing.
+    const std::string picture = args.svg.empty() ? std::string() : render_scene_svg(scene, solution);
     if (args.output.empty()) {
         out << text << std::flush;
     } else {
         write_file_atomically(args.output, text);
     }
+    if (!args.svg.empty()) write_file_atomically(args.svg, picture);
     if (!args.quiet) print_summary(err, scene, solution, args.output);
     return 0;
 }

@@ -19,13 +19,10 @@ struct SolveArgs {
     bool quiet = false;               ///< no summary on stderr
 };
 
-/// Largest dense form-factor matrix the exact solver is allowed to build
-/// (elements^2 x 8 bytes): beyond it a run would swap or be killed rather
-/// than fail cleanly, so it is refused up front with the size it would need.
-constexpr double exact_matrix_limit_bytes = 8.0 * 1024 * 1024 * 1024;
-
 /// Validates `args` (throws UsageError), loads the scene (InputError),
-/// solves it, and writes the result to args.output atomically or to `out`.
+/// refuses a run beyond the exact solver's memory limit (InputError, from
+/// check_exact_solver_memory in solver/exact_solver.h), solves it, and
+/// writes the result to args.output atomically or to `out`.
 /// Nothing is written when any step fails. The summary goes to `err`.
 int run_solve(const SolveArgs& args, std::ostream& out, std::ostream& err);
 

@@ -1,0 +1,148 @@
+// Tests apps/cli/compare_command.h: `flatrad compare`, driven through run_cli.
+#include "cli/compare_command.h"
+
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <doctest/doctest.h>
+#include <nlohmann/json.hpp>
+
+#include "cli/cli.h"
+#include "solver/exact_solver.h"
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+struct Run {
+    int status = -1;
+    std::string out, err;
+};
+
+Run run(const std::vector<std::string>& args) {
+    std::ostringstream out, err;
+    Run r;
+    r.status = flatrad::run_cli(args, out, err);
+    r.out = out.str();
+    r.err = err.str();
+    return r;
+}
+
+// A closed unit box lit by its floor, a pillar casting shadows: small (8
+// patches), so the exact reference converges within a few doublings, and
+// with real discretisation error (shadow edges, corners).
+const char* const pillar_box = R"({"flatrad": 1, "name": "box with a pillar",
+ "materials": {"white": {"reflectance": 0.6}, "lamp": {"reflectance": 0.0, "emission": 1.0}},
+ "surfaces": [
+  {"name": "floor", "material": "lamp", "points": [[0,0],[1,0]], "side": "left"},
+  {"name": "walls", "material": "white", "points": [[1,0],[1,1],[0,1],[0,0]], "side": "left"},
+  {"name": "pillar", "material": "white", "points": [[0.4,0.3],[0.6,0.3],[0.6,0.5],[0.4,0.5]],
+   "closed": true, "side": "out"}]})";
+
+std::string write_scene(const std::string& text) {
+    const fs::path p = fs::temp_directory_path() / ("flatrad_compare_test_" + std::to_string(::getpid()) + ".json");
+    std::ofstream(p) << text;
+    return p.string();
+}
+
+bool finite_number(const json& v) { return v.is_number() && std::isfinite(v.get<double>()); }
+
+}  // namespace
+
+TEST_CASE("compare: JSON fields, finite errors, hierarchical error falls with eps") {
+    const std::string scene = write_scene(pillar_box);
+    double previous = 0;
+    for (const char* eps : {"1e-1", "1e-3"}) {
+        CAPTURE(eps);
+        const Run r = run({"compare", scene, "--eps", eps, "--max-elements", "2100"});
+        REQUIRE(r.status == 0);
+        CHECK(r.err.find("hierarchical") != std::string::npos);  // the table
+        const json j = json::parse(r.out);
+        CHECK(j["scene"] == "box with a pillar");
+        for (const char* side : {"hierarchical", "exact"}) {
+            CAPTURE(side);
+            const json& s = j[side];
+            CHECK(finite_number(s["error"]["relative_l2"]));
+            CHECK(finite_number(s["error"]["max_relative"]));
+            CHECK(finite_number(s["time_s"]));
+            CHECK(s["elements"].get<long>() > 0);
+            CHECK(s["links"].get<long>() > 0);
+            REQUIRE(s["balance"].size() == 1);
+            CHECK(s["balance"][0].get<double>() <= 1e-9);
+        }
+        CHECK(j["hierarchical"]["eps"].get<double>() == std::stod(eps));
+        const json& ref = j["reference"];
+        CHECK(ref["subdivide"].get<long>() >= 32);
+        CHECK(finite_number(ref["error_estimate"]));
+        CHECK(ref["reached"].is_boolean());
+        CHECK(ref["steps"].size() >= 1);
+        // On this scene the target is reached well within 2100 elements.
+        CHECK(ref["reached"].get<bool>());
+        CHECK(ref["error_estimate"].get<double>() <=
+              j["hierarchical"]["error"]["relative_l2"].get<double>() / 10);
+
+        const double err = j["hierarchical"]["error"]["relative_l2"].get<double>();
+        CHECK(err > 0);
+        if (previous > 0) CHECK(err < previous);
+        previous = err;
+    }
+    fs::remove(scene);
+}
+
+TEST_CASE("compare: -o writes the file; bad flags give status 2") {
+    const std::string scene = write_scene(pillar_box);
+    const fs::path out = fs::temp_directory_path() / ("flatrad_compare_out_" + std::to_string(::getpid()) + ".json");
+    const Run r = run({"compare", scene, "-q", "--eps", "0.05", "--subdivide", "8", "--max-elements", "600", "-o",
+                       out.string()});
+    CHECK(r.status == 0);
+    CHECK(r.out.empty());
+    CHECK(r.err.empty());
+    REQUIRE(fs::exists(out));
+    std::ifstream in(out);
+    const json j = json::parse(in);
+    CHECK(j.contains("reference"));
+    fs::remove(out);
+
+    for (const std::vector<std::string>& bad :
+         {std::vector<std::string>{"compare", scene, "--eps", "0"},
+          std::vector<std::string>{"compare", scene, "--subdivide", "0"},
+          std::vector<std::string>{"compare", scene, "--subdivide", "1000", "--max-elements", "100"},
+          std::vector<std::string>{"compare", scene, "--max-elements", "0"}}) {
+        const Run b = run(bad);
+        CHECK(b.status == 2);
+        CHECK(b.err.rfind("error: ", 0) == 0);
+    }
+    fs::remove(scene);
+}
+
+TEST_CASE("compare: the mesh limit stops the doubling and says so") {
+    const std::string scene = write_scene(pillar_box);
+    // 8 patches x 16 = 128 elements; 2K = 256 > 200: no 2K solve at all.
+    const Run r = run({"compare", scene, "-q", "--eps", "1e-3", "--max-elements", "200"});
+    REQUIRE(r.status == 0);
+    const json j = json::parse(r.out);
+    CHECK_FALSE(j["reference"]["reached"].get<bool>());
+    CHECK(j["reference"]["stopped"].get<std::string>().find("--max-elements") != std::string::npos);
+    CHECK(j["reference"]["subdivide"].get<long>() == 16);
+    CHECK(finite_number(j["hierarchical"]["error"]["relative_l2"]));
+    fs::remove(scene);
+}
+
+TEST_CASE("compare_solutions: zero for equal solutions, scale-free") {
+    const std::string path = write_scene(pillar_box);
+    const flatrad::Scene scene = flatrad::load_scene(path);
+    const flatrad::Solution a = flatrad::solve_exact(scene, {2, 0});
+    CHECK(flatrad::compare_solutions(scene, a, a).relative_l2 == 0);
+    CHECK(flatrad::compare_solutions(scene, a, a).worst_patch == -1);
+    flatrad::Solution b = a;
+    for (auto& p : b.patches) p.radiosity[0] *= 1.01;
+    CHECK(flatrad::compare_solutions(scene, b, a).relative_l2 == doctest::Approx(0.01).epsilon(1e-9));
+    fs::remove(path);
+}
