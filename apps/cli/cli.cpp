@@ -77,7 +77,7 @@ void add_solve(CLI::App& app, Commands& c) {
     cmd->add_option("--method", a.method,
                     "exact: every patch cut into K equal elements, every pair's exact form factor, "
                     "one dense linear system (the reference; the default for now). hierarchical: "
-                    "not available yet.")
+                    "element trees, refined links, multi-scale visibility (no clustering yet; --eps, --vis-eps).")
         ->type_name("METHOD")
         ->check(CLI::IsMember({"exact", "hierarchical"}))
         ->capture_default_str();
