@@ -8,6 +8,7 @@
 
 #include "engine/error.h"
 #include "engine/hierarchy.h"
+#include "solver/closed_enclosure.h"
 #include "engine/compensated_sum.h"
 #include "visibility/exact_visibility.h"
 
@@ -15,12 +16,6 @@ namespace flatrad {
 
 namespace {
 
-// A reflectance-1 element whose form factors into other reflectance-1
-// elements sum to more than 1 - this keeps all its light in that set. The
-// form factors are exact to ~1e-13 (closure tests), so 1e-9 only catches
-// enclosures that are closed up to rounding, while any real opening or
-// absorber (even one 1e-6 of the view) counts as a leak.
-constexpr double closure_tolerance = 1e-9;
 
 struct Element {
     Segment seg;   // oriented lit-left
@@ -33,32 +28,6 @@ struct Element {
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
-// Finds a set of elements that keeps all light among itself with
-// reflectance 1 in channel c: then I - rho F is singular (DESIGN.md §3).
-// Repeatedly drops elements that leak out of the candidate set.
-std::vector<int> closed_white_set(const Eigen::MatrixXd& F, const std::vector<double>& rho) {
-    const int n = static_cast<int>(rho.size());
-    std::vector<char> in(static_cast<size_t>(n));
-    for (int a = 0; a < n; ++a) in[static_cast<size_t>(a)] = rho[static_cast<size_t>(a)] == 1.0;
-    bool changed = true;
-    while (changed) {
-        changed = false;
-        for (int a = 0; a < n; ++a) {
-            if (!in[static_cast<size_t>(a)]) continue;
-            CompensatedSum kept;
-            for (int b = 0; b < n; ++b)
-                if (in[static_cast<size_t>(b)]) kept.add(F(a, b));
-            if (kept.value() < 1 - closure_tolerance) {
-                in[static_cast<size_t>(a)] = 0;
-                changed = true;
-            }
-        }
-    }
-    std::vector<int> set;
-    for (int a = 0; a < n; ++a)
-        if (in[static_cast<size_t>(a)]) set.push_back(a);
-    return set;
-}
 
 }  // namespace
 
@@ -153,19 +122,9 @@ Solution solve_exact(const Scene& scene, const ExactSolverOptions& options) {
         }
         const std::vector<int> closed = closed_white_set(F, rho);
         if (!closed.empty()) {
-            std::string names;
-            int listed = -1;
-            for (int a : closed) {
-                const int surf = scene.patches[static_cast<size_t>(elems[static_cast<size_t>(a)].patch)].surface;
-                if (surf == listed || names.find("'" + scene.surfaces[static_cast<size_t>(surf)].name + "'") != std::string::npos)
-                    continue;
-                listed = surf;
-                names += (names.empty() ? "'" : ", '") + scene.surfaces[static_cast<size_t>(surf)].name + "'";
-            }
-            throw InputError(scene.file, "",
-                             fmt::format("no unique solution: {} enclose(s) light with reflectance 1{} and "
-                                         "nothing absorbs it; lower a reflectance below 1",
-                                         names, C > 1 ? fmt::format(" in channel {}", c) : std::string{}));
+            std::vector<int> patches;
+            for (int a : closed) patches.push_back(elems[static_cast<size_t>(a)].patch);
+            refuse_closed_white(scene, patches, c);
         }
         Eigen::MatrixXd A = -F;
         for (int a = 0; a < n; ++a) {

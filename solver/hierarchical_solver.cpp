@@ -1,4 +1,5 @@
 #include "solver/hierarchical_solver.h"
+#include "solver/closed_enclosure.h"
 
 #include <omp.h>
 
@@ -20,10 +21,8 @@ namespace flatrad {
 
 namespace {
 
-// Same meaning and size as in the exact solver: a reflectance-1 patch whose
-// exact form factors into the reflectance-1 set sum to more than 1 - this
-// keeps its light there (form factors are exact to ~1e-13).
-constexpr double closure_tolerance = 1e-9;
+// closure_tolerance (solver/closed_enclosure.h) also serves below to tell
+// a row sum of 1 from rounding.
 
 // GMRES stops at ||E - (I - rho G) B|| <= gmres_tolerance ||E||. The
 // operator is applied in double with sums of at most a few thousand terms,
@@ -203,33 +202,13 @@ void HierarchicalSolver::refuse_closed_white() const {
                 F(a, b) = exact.exchange(pa.oriented(m_scene.segments), pb.oriented(m_scene.segments), pa.segment,
                                          pb.segment, ws, st) / pa.length;
             }
-        std::vector<char> in(static_cast<size_t>(n), 1);
-        bool changed = true;
-        while (changed) {
-            changed = false;
-            for (int a = 0; a < n; ++a) {
-                if (!in[static_cast<size_t>(a)]) continue;
-                CompensatedSum kept;
-                for (int b = 0; b < n; ++b)
-                    if (in[static_cast<size_t>(b)]) kept.add(F(a, b));
-                if (kept.value() < 1 - closure_tolerance) {
-                    in[static_cast<size_t>(a)] = 0;
-                    changed = true;
-                }
-            }
+        std::vector<double> rho(static_cast<size_t>(n), 1.0);
+        const std::vector<int> closed = closed_white_set(F, rho);
+        if (!closed.empty()) {
+            std::vector<int> patches;
+            for (int a : closed) patches.push_back(white[static_cast<size_t>(a)]);
+            flatrad::refuse_closed_white(m_scene, patches, c);
         }
-        std::string names;
-        for (int a = 0; a < n; ++a) {
-            if (!in[static_cast<size_t>(a)]) continue;
-            const std::string nm =
-                "'" + m_scene.surfaces[static_cast<size_t>(m_scene.patches[static_cast<size_t>(white[static_cast<size_t>(a)])].surface)].name + "'";
-            if (names.find(nm) == std::string::npos) names += (names.empty() ? "" : ", ") + nm;
-        }
-        if (!names.empty())
-            throw InputError(m_scene.file, "",
-                             fmt::format("no unique solution: {} enclose(s) light with reflectance 1{} and "
-                                         "nothing absorbs it; lower a reflectance below 1",
-                                         names, m_C > 1 ? fmt::format(" in channel {}", c) : std::string{}));
     }
 }
 
