@@ -1,5 +1,6 @@
 // Tests apps/cli/cli.h: the `flatrad` command line, driven in-process.
 #include "cli/cli.h"
+#include "support/cli_run.h"
 
 #include <unistd.h>
 
@@ -17,62 +18,17 @@
 namespace fs = std::filesystem;
 using nlohmann::json;
 
+using flatrad::test::is_one_error_line;
+using flatrad::test::read_text;
+using flatrad::test::Run;
+using flatrad::test::run;
+using flatrad::test::TempDir;
+
 namespace {
 
-struct Run {
-    int status = -1;
-    std::string out, err;
-};
 
-Run run(const std::vector<std::string>& args) {
-    std::ostringstream out, err;
-    Run r;
-    r.status = flatrad::run_cli(args, out, err);
-    r.out = out.str();
-    r.err = err.str();
-    return r;
-}
 
-// SPEC: an error is exactly one line on stderr, starting "error: ".
-bool is_one_error_line(const std::string& err) {
-    return err.rfind("error: ", 0) == 0 && err.find('\n') == err.size() - 1;
-}
 
-// A fresh directory under the system's temp dir, removed with its contents.
-class TempDir {
-public:
-    TempDir() {
-        static std::atomic<int> counter{0};
-        m_path = fs::temp_directory_path() /
-                 ("flatrad_cli_test_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
-        fs::remove_all(m_path);
-        fs::create_directories(m_path);
-    }
-    ~TempDir() {
-        std::error_code ec;
-        fs::remove_all(m_path, ec);
-    }
-    TempDir(const TempDir&) = delete;
-    TempDir& operator=(const TempDir&) = delete;
-
-    std::string file(const std::string& name, const std::string& text) const {
-        const fs::path p = m_path / name;
-        std::ofstream(p) << text;
-        return p.string();
-    }
-    std::string path(const std::string& name) const { return (m_path / name).string(); }
-    const fs::path& dir() const { return m_path; }
-
-private:
-    fs::path m_path;
-};
-
-std::string read_text(const std::string& path) {
-    std::ifstream in(path);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
 
 // Two unit segments facing each other at distance 1: the lamp below (its
 // left, +y, is lit) and a grey plate above (points right to left, so its

@@ -14,26 +14,20 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/cli.h"
+#include "support/cli_run.h"
 #include "solver/exact_solver.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
 
+using flatrad::test::is_one_error_line;
+using flatrad::test::read_text;
+using flatrad::test::Run;
+using flatrad::test::run;
+using flatrad::test::TempDir;
+
 namespace {
 
-struct Run {
-    int status = -1;
-    std::string out, err;
-};
-
-Run run(const std::vector<std::string>& args) {
-    std::ostringstream out, err;
-    Run r;
-    r.status = flatrad::run_cli(args, out, err);
-    r.out = out.str();
-    r.err = err.str();
-    return r;
-}
 
 // A closed unit box lit by its floor, a pillar casting shadows: small (8
 // patches), so the exact reference converges within a few doublings, and

@@ -14,31 +14,19 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/cli.h"
+#include "support/cli_run.h"
 
 namespace fs = std::filesystem;
 
+using flatrad::test::is_one_error_line;
+using flatrad::test::read_text;
+using flatrad::test::Run;
+using flatrad::test::run;
+using flatrad::test::TempDir;
+
 namespace {
 
-struct Run {
-    int status = -1;
-    std::string out, err;
-};
 
-Run run(const std::vector<std::string>& args) {
-    std::ostringstream out, err;
-    Run r;
-    r.status = flatrad::run_cli(args, out, err);
-    r.out = out.str();
-    r.err = err.str();
-    return r;
-}
-
-std::string read_text(const fs::path& path) {
-    std::ifstream in(path);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
 
 size_t count(const std::string& text, const std::string& word) {
     size_t n = 0;

@@ -16,59 +16,21 @@
 #include <doctest/doctest.h>
 
 #include "cli/cli.h"
+#include "support/cli_run.h"
 #include "cli/svg_plot.h"
 #include "cli/usage_error.h"
 
 namespace fs = std::filesystem;
 
+using flatrad::test::is_one_error_line;
+using flatrad::test::read_text;
+using flatrad::test::Run;
+using flatrad::test::run;
+using flatrad::test::TempDir;
+
 namespace {
 
-struct Run {
-    int status = -1;
-    std::string out, err;
-};
 
-Run run(const std::vector<std::string>& args) {
-    std::ostringstream out, err;
-    Run r;
-    r.status = flatrad::run_cli(args, out, err);
-    r.out = out.str();
-    r.err = err.str();
-    return r;
-}
-
-bool is_one_error_line(const std::string& err) {
-    return err.rfind("error: ", 0) == 0 && err.find('\n') == err.size() - 1;
-}
-
-class TempDir {
-public:
-    TempDir() {
-        static std::atomic<int> counter{0};
-        m_path = fs::temp_directory_path() /
-                 ("flatrad_sweep_test_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
-        fs::remove_all(m_path);
-        fs::create_directories(m_path);
-    }
-    ~TempDir() {
-        std::error_code ec;
-        fs::remove_all(m_path, ec);
-    }
-    TempDir(const TempDir&) = delete;
-    TempDir& operator=(const TempDir&) = delete;
-    std::string path(const std::string& name) const { return (m_path / name).string(); }
-    const fs::path& dir() const { return m_path; }
-
-private:
-    fs::path m_path;
-};
-
-std::string read_text(const std::string& path) {
-    std::ifstream in(path);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
 
 std::vector<std::string> split(const std::string& s, char sep) {
     std::vector<std::string> out;
