@@ -35,7 +35,7 @@ struct PairGeometry {
     bool visible = false;
     Segment ci, cj;        // mutually clipped
     double L_i = 0;        // unclipped length of i (F is per unit length of i)
-    Vec2 origin, u;        // frame: origin at ci's midpoint, u bisecting the directions
+    Vec2 origin, u;        // frame (PairFrame in shaft.h): origin and axis bisecting the directions
     double theta_u = 0;    // absolute direction of u
     double delta_theta = 0;  // half spread of directions of lines meeting both
     double r_min = 0;      // distance between the clipped patches
@@ -311,7 +311,7 @@ struct MixedIntegral {
     }
 
     double integrate(const Segment& ci, const Segment& cj, const std::vector<Segment>& exact, double tol) {
-        // Frame: origin at ci's midpoint, axis bisecting the directions.
+        // Frame (shaft.h): origin at the shorter patch, axis bisecting the directions.
         PairGeometry g;
         g.visible = true;
         g.ci = ci;

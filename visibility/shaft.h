@@ -133,7 +133,7 @@ inline bool add_blocker(const Shaft& shaft, const Segment& s, [[maybe_unused]] d
 }
 
 // The frame of a facing pair (DESIGN §1, directions measured from the
-// pair's own axis): origin at ci's midpoint, axis u bisecting the range of
+// pair's own axis): origin at the shorter patch's midpoint, axis u bisecting the range of
 // directions of lines meeting both, so that the range is
 // [-delta_theta, delta_theta] with delta_theta < pi/2 and the slope
 // tan(phi) is a monotone, well-conditioned parameter inside it.
@@ -142,8 +142,14 @@ struct PairFrame {
     double theta_u = 0;      // absolute direction of u
     double delta_theta = 0;  // half the range of directions
 
-    PairFrame(const Segment& ci, const Segment& cj) : origin(ci.midpoint()) {
-        Vec2 u0 = cj.midpoint() - origin;
+    // The origin sits at the shorter patch's midpoint: local coordinates
+    // carry rounding of the size of their distance to the origin, and the
+    // differences that decide the result are those near the shorter patch
+    // (beside a 5e14-long wall, a 0.04 patch's points taken relative to the
+    // wall's midpoint would be off by 0.03: the fuzzer's case).
+    PairFrame(const Segment& ci, const Segment& cj)
+        : origin(norm_squared(ci.b - ci.a) <= norm_squared(cj.b - cj.a) ? ci.midpoint() : cj.midpoint()) {
+        Vec2 u0 = cj.midpoint() - ci.midpoint();
         u0 = u0 / norm(u0);
         double lo = std::numeric_limits<double>::infinity(), hi = -lo;
         for (Vec2 A : {ci.a, ci.b})
