@@ -266,6 +266,7 @@ public:
 
         read_materials(require(root, "materials", ""), scene);
         read_surfaces(require(root, "surfaces", ""), scene);
+        check_no_overlaps(scene);
         return scene;
     }
 
@@ -732,6 +733,58 @@ private:
         if (opposite(o1, o2) && opposite(o3, o4)) return true;
         return (o1 == 0 && within(a, b, c)) || (o2 == 0 && within(a, b, d)) || (o3 == 0 && within(c, d, a)) ||
                (o4 == 0 && within(c, d, b));
+    }
+
+    // Two segments on one line overlapping over a positive length put two
+    // surfaces in the same place: whatever is in front sees both (a lit
+    // patch or a black unlit side twice), so row sums of F exceed 1 and a
+    // stiff scene solves to negative radiosity (found by the fuzzer). Such
+    // a scene is refused; segments meeting end to end, or crossing, are fine.
+    // Candidates come from the cluster hierarchy: O(N log N) for the check.
+    void check_no_overlaps(const Scene& scene) const {
+        const std::vector<Segment> geometry = scene.segment_geometry();
+        if (geometry.size() < 2) return;
+        const Hierarchy hierarchy(geometry, 2);
+        std::vector<int32_t> stack;
+        // Points off a line by a few ulps of the coordinates are on it; a
+        // sliver 3 wide at 1e15 (24 ulps) is real geometry and is kept.
+        const double rounding = 4 * std::numeric_limits<double>::epsilon();
+        auto magnitude = [](const Segment& g) {
+            return std::max({std::abs(g.a.x), std::abs(g.a.y), std::abs(g.b.x), std::abs(g.b.y)});
+        };
+        for (size_t s = 0; s < geometry.size(); ++s) {
+            const Segment& g = geometry[s];
+            const double L = g.length();
+            Box box;
+            box.add(g);
+            const double pad = rounding * (magnitude(g) + L);
+            box.lo -= Vec2{pad, pad};
+            box.hi += Vec2{pad, pad};
+            hierarchy.query(
+                [&](const Box& b) {
+                    return !(b.hi.x < box.lo.x || b.lo.x > box.hi.x || b.hi.y < box.lo.y || b.lo.y > box.hi.y);
+                },
+                [&](int t, const Segment& h) {
+                    if (t <= static_cast<int>(s)) return;
+                    const double tol = rounding * (std::max(magnitude(g), magnitude(h)) + std::max(L, h.length()));
+                    // On g's line (distance within rounding) ...
+                    if (std::abs(orient(g.a, g.b, h.a)) > tol * L || std::abs(orient(g.a, g.b, h.b)) > tol * L) return;
+                    // ... and overlapping it over more than rounding.
+                    const Vec2 d = (g.b - g.a) / L;
+                    const double u0 = dot(h.a - g.a, d), u1 = dot(h.b - g.a, d);
+                    const double overlap = std::min(L, std::max(u0, u1)) - std::max(0.0, std::min(u0, u1));
+                    if (overlap <= tol) return;
+                    const SceneSegment& a = scene.segments[s];
+                    const SceneSegment& b = scene.segments[static_cast<size_t>(t)];
+                    fail(fmt::format("surfaces[{}].points[{}]", b.surface, b.index),
+                         fmt::format("segment {} of surface \"{}\" lies on segment {} of surface \"{}\" over a "
+                                     "length of {:g}: two surfaces in one place would each be seen twice; "
+                                     "remove the overlap (segments may meet end to end or cross)",
+                                     b.index, scene.surfaces[static_cast<size_t>(b.surface)].name, a.index,
+                                     scene.surfaces[static_cast<size_t>(a.surface)].name, overlap));
+                },
+                stack);
+        }
     }
 
     /// Appends the surface's segments and patches in SPEC numbering: segment

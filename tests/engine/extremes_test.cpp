@@ -140,12 +140,20 @@ TEST_CASE("extremes: collinear and overlapping segments exchange nothing") {
         CHECK(form_factor_unoccluded(i, j) == 0);
         CHECK(form_factor_unoccluded(j, i) == 0);
     }
-    // The reader accepts overlapping surfaces (they are legal geometry).
+    // The reader refuses overlapping surfaces: two surfaces in one place
+    // would each be seen twice (row sums of F above 1; the fuzzer found a
+    // stiff scene solving to negative radiosity). Meeting end to end is fine.
+    CHECK_THROWS_AS(parse_scene(
+                        R"({"flatrad": 1, "materials": {"m": {}}, "surfaces": [
+            {"name": "a", "material": "m", "points": [[0, 0], [2, 0]]},
+            {"name": "b", "material": "m", "points": [[1, 0], [3, 0]], "side": "both"}]})",
+                        "overlap.json"),
+                    InputError);
     CHECK_NOTHROW(parse_scene(
         R"({"flatrad": 1, "materials": {"m": {}}, "surfaces": [
             {"name": "a", "material": "m", "points": [[0, 0], [2, 0]]},
-            {"name": "b", "material": "m", "points": [[1, 0], [3, 0]], "side": "both"}]})",
-        "overlap.json"));
+            {"name": "b", "material": "m", "points": [[2, 0], [3, 0]], "side": "both"}]})",
+        "touching.json"));
 }
 
 TEST_CASE("extremes: facing plates 1e-9 apart, and nearly flat wedges") {

@@ -218,10 +218,15 @@ TEST_CASE("scene: zero area with side in or out") {
     CHECK_REFUSED(scene_json(surface(R"("points": [[0, 0], [1, 1], [1, 0], [0, 1]], "closed": true,
                                         "side": "out")")),
                   "surfaces[0].points");
-    // "both" needs no area: the shape is still a set of blocking segments.
-    CHECK_NOTHROW(parse_scene(scene_json(surface(R"("points": [[0, 0], [1, 0], [2, 0]], "closed": true,
+    // "both" needs no area: a thin closed shape is still a set of blocking
+    // segments...
+    CHECK_NOTHROW(parse_scene(scene_json(surface(R"("points": [[0, 0], [1, 0], [2, 0.5]], "closed": true,
                                                     "side": "both")")),
                               label));
+    // ... but a flat one lies on itself (its closing segment covers the
+    // others): refused as overlapping segments, naming the closing one.
+    CHECK_REFUSED(scene_json(surface(R"("points": [[0, 0], [1, 0], [2, 0]], "closed": true, "side": "both")")),
+                  "surfaces[0].points[2]");
 }
 
 TEST_CASE("scene: a self-crossing polygon with side in or out") {
