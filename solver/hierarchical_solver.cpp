@@ -1,5 +1,6 @@
 #include "solver/hierarchical_solver.h"
 #include "solver/closed_enclosure.h"
+#include "solver/reachability.h"
 
 #include <omp.h>
 
@@ -7,6 +8,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <fmt/format.h>
 
 #include "engine/compensated_sum.h"
@@ -167,6 +169,7 @@ private:
     std::vector<Node> m_nodes;
     int m_patch_roots = 0;  // nodes [0, patches) are patch roots, then sink roots
     std::vector<Link> m_links;
+    long m_left_out = 0;              // patches no emitter can reach (no links)
     std::vector<int> m_leaves;        // patch-tree leaves
     std::vector<char> m_closed;       // per patch: sees only lit patches (row sum 1)
     // Per leaf of a closed patch: the row-sum deficit 1 - (own + ancestors'
@@ -288,6 +291,45 @@ void HierarchicalSolver::initial_links() {
             links.push_back({r, s});
         }
     compute_links(links);
+    // Pay only for what can be lit (solver/reachability.h): patches joined
+    // by a link that may carry light (F, or its visibility bound, above 0)
+    // exchange both ways; a link whose sender no emitter can reach carries
+    // nothing, ever. Such links live only among unreached patches, so
+    // dropping them leaves every reached patch's links as they were.
+    // A pair whose approximate F cannot be told from 0 (F within its
+    // visibility bound) is settled by the exact exchange.
+    std::vector<std::pair<int, int>> exchanging;
+    const ExactVisibility exact(m_hierarchy);
+    ExactWorkspace ws;
+    for (const Link& l : links) {
+        if (l.r >= P || l.r > l.s) continue;
+        // Grazing corners leave form factors of rounding size (1e-33 seen);
+        // below 64 ulps a pair is taken as dark: it could carry at most that
+        // fraction of its light.
+        constexpr double noise = 64 * std::numeric_limits<double>::epsilon();
+        bool carries = l.F > l.vis_err + noise;
+        if (!carries && l.F + l.vis_err > noise) {
+            const Node& nr = m_nodes[static_cast<size_t>(l.r)];
+            const Node& ns = m_nodes[static_cast<size_t>(l.s)];
+            carries = exact.exchange(nr.seg, ns.seg, nr.segment, ns.segment, ws, m_stats) >
+                      noise * std::min(nr.length, ns.length);
+        }
+        if (carries) exchanging.push_back({l.r, l.s});
+    }
+    std::vector<char> emits(static_cast<size_t>(P), 0);
+    for (int p = 0; p < P; ++p)
+        for (int c = 0; c < m_C; ++c) emits[static_cast<size_t>(p)] = emits[static_cast<size_t>(p)] || emission(p, c) > 0;
+    const std::vector<char> reached = reachable_patches(P, exchanging, emits);
+    m_left_out = 0;
+    for (int p = 0; p < P; ++p) m_left_out += reached[static_cast<size_t>(p)] ? 0 : 1;
+    // Drop links from unreached senders, and links into unreached patches
+    // (only rounding-level F can join the two: they would carry noise).
+    links.erase(std::remove_if(links.begin(), links.end(),
+                               [&](const Link& l) {
+                                   return !reached[static_cast<size_t>(l.s)] ||
+                                          (l.r < P && !reached[static_cast<size_t>(l.r)]);
+                               }),
+                links.end());
     m_links = std::move(links);
     // A patch whose links to lit patches sum to 1 sees nothing else (no
     // sink, no escape) at any of its points: the escape fraction and the
@@ -618,6 +660,7 @@ Solution HierarchicalSolver::run() {
     sol.stats.linear_solve_time_s = m_solve_time;
     sol.stats.elements = static_cast<long>(m_leaves.size());
     sol.stats.links = static_cast<long>(m_links.size());
+    sol.stats.patches_left_out = m_left_out;
     sol.stats.iterations = m_iterations;
     sol.stats.residual = m_residual;
     sol.stats.threads = m_threads;
