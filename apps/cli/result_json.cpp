@@ -28,6 +28,7 @@ ordered_json visibility_stats_json(const VisibilityStats& s) {
     j["blockers"] = s.blockers;
     j["events"] = s.events;
     j["separated"] = s.separated;
+    j["subshafts"] = s.subshafts;
     return j;
 }
 

@@ -14,7 +14,7 @@
 #include <random>
 #include <vector>
 
-#include "support/clouds.h"
+#include "support/cloud_visibility.h"
 #include "engine/formfactor.h"
 #include "visibility/multiscale.h"
 
@@ -42,10 +42,9 @@ int main(int argc, char** argv) {
     std::mt19937_64 rng(seed);
     for (int t = 0; t < configs; ++t) {
         const test::Cloud c = test::make_cloud(rng);
-        const Hierarchy h(c.segments);
-        const ClusterTables tables(h);
-        const MultiscaleVisibility ms(h, tables);
-        const ExactVisibility ex(h);
+        const test::CloudVisibility vis(c);
+        const MultiscaleVisibility& ms = vis.multiscale;
+        const ExactVisibility& ex = vis.exact;
         ExactWorkspace ws;
         VisibilityStats st;
         auto t0 = std::chrono::steady_clock::now();

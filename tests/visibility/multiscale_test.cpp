@@ -9,7 +9,7 @@
 #include <random>
 
 #include "engine/formfactor.h"
-#include "support/clouds.h"
+#include "support/cloud_visibility.h"
 
 using namespace flatrad;
 
@@ -56,10 +56,9 @@ TEST_CASE("multiscale: eps = 0 approximates nothing and is exact, on 200 random 
     int nonzero = 0;
     for (int t = 0; t < 200; ++t) {
         const test::Cloud c = test::make_cloud(rng);
-        const Hierarchy h(c.segments);
-        const ClusterTables tables(h);
-        const MultiscaleVisibility ms(h, tables);
-        const ExactVisibility ex(h);
+        const test::CloudVisibility vis(c);
+        const MultiscaleVisibility& ms = vis.multiscale;
+        const ExactVisibility& ex = vis.exact;
         ExactWorkspace ws;
         VisibilityStats st;
         const double exact = ex.form_factor(c.i, c.j, 0, 1, ws, st);
@@ -80,10 +79,9 @@ TEST_CASE("multiscale: the reported error bound holds (rule: bound), and F -> ex
     double sum_err[6] = {};
     for (int t = 0; t < 120; ++t) {
         const test::Cloud c = test::make_cloud(rng);
-        const Hierarchy h(c.segments);
-        const ClusterTables tables(h);
-        const MultiscaleVisibility ms(h, tables);
-        const ExactVisibility ex(h);
+        const test::CloudVisibility vis(c);
+        const MultiscaleVisibility& ms = vis.multiscale;
+        const ExactVisibility& ex = vis.exact;
         ExactWorkspace ws;
         VisibilityStats st;
         const double exact = ex.form_factor(c.i, c.j, 0, 1, ws, st);
