@@ -72,6 +72,9 @@
 ///    error shows as `escaped` in a closed scene (the links spread a
 ///    sender's mean B, not its leaves' values): 1e-3 of the emitted power
 ///    on data/default.json at eps = 1e-3, 9e-3 at eps = 1e-2.
+#include <functional>
+#include <string>
+
 #include "engine/scene.h"
 #include "solver/solution.h"
 
@@ -83,6 +86,11 @@ struct HierarchicalOptions {
     int max_depth = 12;      ///< deepest element level (a patch is level 0)
     int max_passes = 8;      ///< refine-solve rounds at most
     int threads = 0;         ///< 0: all cores
+    /// Called now and then from the solving thread with what is being done
+    /// ("refine pass 2", "solve", ...) and a fraction in [0, 1] of the whole
+    /// run when one is known (< 0 otherwise). Empty: no reports. The CLI
+    /// draws it on stderr when that is a terminal (--quiet silences it).
+    std::function<void(const std::string& stage, double fraction)> progress;
 };
 
 /// Solves `scene` hierarchically. Throws InputError for eps <= 0 or not
