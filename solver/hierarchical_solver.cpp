@@ -1,6 +1,4 @@
 #include "solver/hierarchical_solver.h"
-#include "solver/closed_enclosure.h"
-#include "solver/reachability.h"
 
 #include <omp.h>
 
@@ -12,9 +10,14 @@
 #include <fmt/format.h>
 
 #include "engine/compensated_sum.h"
+#include "engine/convex_scene.h"
 #include "engine/error.h"
 #include "engine/formfactor.h"
 #include "engine/hierarchy.h"
+#include "solver/closed_enclosure.h"
+#include "solver/directional.h"
+#include "solver/gmres.h"
+#include "solver/reachability.h"
 #include "visibility/cluster_tables.h"
 #include "visibility/exact_visibility.h"
 #include "visibility/multiscale.h"
@@ -23,103 +26,79 @@ namespace flatrad {
 
 namespace {
 
-// closure_tolerance (solver/closed_enclosure.h) also serves below to tell
-// a row sum of 1 from rounding.
+constexpr int K = directional_bins;
 
-// GMRES stops at ||E - (I - rho G) B|| <= gmres_tolerance ||E||. The
-// operator is applied in double with sums of at most a few thousand terms,
-// so 1e-12 is reachable and keeps B to ~1e-9 relative even where
+// GMRES stops at ||E - (I - rho G) B|| <= 1e-12 ||E||: the operator is
+// applied in double with sums of at most a few thousand terms per node, so
+// 1e-12 is reachable and keeps B to ~1e-9 relative even where
 // 1 / (1 - rho) = 1000 (white furnace 0.999).
 constexpr double gmres_tolerance = 1e-12;
-constexpr int gmres_restart = 60;
-constexpr int gmres_max_applications = 2000;
 
-struct Node {
-    Segment seg;       // oriented lit-left
-    int patch = -1;    // patch number; -1 for a sink
-    int segment = -1;  // scene segment (blocker to skip)
-    double s0 = 0, s1 = 1;  // parameter along the oriented patch
-    double length = 0;
-    int child = -1;    // first child; the second is child + 1
-    int parent = -1;
-    int depth = 0;
-    bool sink() const { return patch < 0; }
+enum class Kind : uint8_t {
+    Cluster,  // a node of the scene's cluster hierarchy
+    Element,  // a patch (lit side of a segment) or a piece of one
+    Sink,     // an unlit side: black, receives only (SPEC)
 };
 
+struct Node {
+    Kind kind = Kind::Cluster;
+    bool leaf_cluster = false;  // a hierarchy leaf: its children are its segments' sides
+    bool can_send = false;      // some patch below reflects or emits
+    int32_t child = -1;         // first child; children are contiguous
+    int32_t nchild = 0;
+    int32_t parent = -1;
+    int32_t hnode = -1;         // hierarchy node (clusters; elements: their segment's leaf)
+    int32_t patch = -1;         // elements
+    int32_t segment = -1;       // elements and sinks
+    int32_t table = -1;         // clusters: index of the directional tables
+    int16_t depth = 0;          // elements: level below the patch
+    Segment seg;                // elements and sinks: oriented, lit (or receiving) side on the left
+    Vec2 normal;                // elements and sinks: unit normal of that side
+    Vec2 center;
+    double radius = 0;          // half the box diagonal (clusters), half the length (elements)
+    double length = 0;          // elements and sinks
+    double s0 = 0, s1 = 1;      // elements: parameter range along the oriented patch
+    bool cluster() const { return kind == Kind::Cluster; }
+    bool sink() const { return kind == Kind::Sink; }
+};
+
+// A link carries light from sender s to receiver r (DESIGN.md §3).
+//   sender value v = I_s(phi) (cluster: exitance table read at the link's
+//                    direction) or B_s (element);
+//   contribution c = coef * v;
+//   receiver: H_r += c (element or sink), or J_r += c spread on the two
+//             samples around psi (cluster).
+// coef by kind (tau = transmittance, d = distance between centres):
+//   element <- element: F_rs (exact average over r; MultiscaleVisibility);
+//   element <- cluster: tau * Delta_r / L_r, Delta_r the angle r subtends
+//                       from the cluster's centre (point source);
+//   cluster <- element: tau / d * (L_s / 2) cos+(n_s . u);
+//   cluster <- cluster: tau / d.
 struct Link {
-    int r = -1, s = -1;   // receiver, sender
-    double F = 0;         // F_rs (per unit length of r)
-    double Fu = 0;        // unoccluded F_rs
-    double vis_err = 0;   // multiscale bound on |F - F_exact|
-    double w = 0;         // how unevenly F spreads over r: L_r (kernel + occlusion variation)
+    int32_t r = -1, s = -1;
+    double coef = 0;
+    BinWeight sbin, rbin;     // exitance direction at s, arrival direction at r
+    float tau = 1;            // transmittance (cluster links), F / F_unoccluded (element links)
+    float vis_err = 0;        // visibility bound: on tau (cluster links) or on F (element links)
+    float geo = 0;            // cluster links: relative error of the point approximation
+    float Fu = 0;             // element links: unoccluded F
+    bool unresolved = false;  // cluster links whose nodes overlap: must be split if they carry light
+};
+
+Link link_between(int r, int s) {
+    Link l;
+    l.r = r;
+    l.s = s;
+    return l;
+}
+
+struct LinkError {
+    double err = 0;       // estimated error in transported power
+    bool split_r = true;  // the receiver's side makes most of it
 };
 
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
-
-// Restarted GMRES with Givens rotations (Saad & Schultz 1986) for A x = b,
-// A given as apply(x) -> A x. Returns the number of applications.
-template <class Apply>
-long gmres(const Apply& apply, const Eigen::VectorXd& b, Eigen::VectorXd& x, double& rel_residual) {
-    const double bnorm = b.norm();
-    long apps = 0;
-    if (bnorm == 0) {
-        x.setZero();
-        rel_residual = 0;
-        return 0;
-    }
-    const int n = static_cast<int>(b.size());
-    const int m = std::min(gmres_restart, n);
-    Eigen::MatrixXd V(n, m + 1), H = Eigen::MatrixXd::Zero(m + 1, m);
-    Eigen::VectorXd cs(m), sn(m), g(m + 1);
-    Eigen::VectorXd r = b - apply(x);
-    ++apps;
-    double beta = r.norm();
-    rel_residual = beta / bnorm;
-    while (rel_residual > gmres_tolerance && apps < gmres_max_applications) {
-        V.col(0) = r / beta;
-        g.setZero();
-        g(0) = beta;
-        H.setZero();
-        int k = 0;
-        for (; k < m && apps < gmres_max_applications; ++k) {
-            Eigen::VectorXd w = apply(V.col(k));
-            ++apps;
-            for (int i = 0; i <= k; ++i) {  // modified Gram-Schmidt
-                H(i, k) = w.dot(V.col(i));
-                w -= H(i, k) * V.col(i);
-            }
-            H(k + 1, k) = w.norm();
-            if (H(k + 1, k) > 0) V.col(k + 1) = w / H(k + 1, k);
-            for (int i = 0; i < k; ++i) {
-                const double t = cs(i) * H(i, k) + sn(i) * H(i + 1, k);
-                H(i + 1, k) = -sn(i) * H(i, k) + cs(i) * H(i + 1, k);
-                H(i, k) = t;
-            }
-            const double d = std::hypot(H(k, k), H(k + 1, k));
-            cs(k) = d > 0 ? H(k, k) / d : 1;
-            sn(k) = d > 0 ? H(k + 1, k) / d : 0;
-            H(k, k) = d;
-            H(k + 1, k) = 0;
-            g(k + 1) = -sn(k) * g(k);
-            g(k) = cs(k) * g(k);
-            if (std::abs(g(k + 1)) <= gmres_tolerance * bnorm || H(k, k) == 0) {
-                ++k;
-                break;
-            }
-        }
-        // Solve the small triangular system and update x.
-        Eigen::VectorXd y = H.topLeftCorner(k, k).triangularView<Eigen::Upper>().solve(g.head(k));
-        x += V.leftCols(k) * y;
-        r = b - apply(x);
-        ++apps;
-        beta = r.norm();
-        const double prev = rel_residual;
-        rel_residual = beta / bnorm;
-        if (!(rel_residual < prev)) break;  // stagnation: no progress in a whole cycle
-    }
-    return apps;
-}
 
 class HierarchicalSolver {
 public:
@@ -127,11 +106,12 @@ public:
         : m_scene(scene),
           m_opt(o),
           m_C(scene.channels),
-          m_hierarchy(scene.segment_geometry()),
+          m_hierarchy(scene.segment_geometry(), 1),
           m_tables(m_hierarchy),
           m_vis(m_hierarchy, m_tables) {
         m_threads = o.threads > 0 ? o.threads : omp_get_max_threads();
         m_vis_eps = o.vis_eps >= 0 ? o.vis_eps : o.eps / 10;
+        m_unblockable = no_segment_can_block(scene);
     }
 
     Solution run();
@@ -142,46 +122,70 @@ private:
     }
     double rho(int node, int c) const {
         const Node& n = m_nodes[static_cast<size_t>(node)];
-        return n.sink() ? 0.0 : material(n.patch).reflectance[static_cast<size_t>(c)];
+        return n.kind == Kind::Element ? material(n.patch).reflectance[static_cast<size_t>(c)] : 0.0;
     }
     double emission(int node, int c) const {
         const Node& n = m_nodes[static_cast<size_t>(node)];
-        return n.sink() ? 0.0 : material(n.patch).emission[static_cast<size_t>(c)];
+        return n.kind == Kind::Element ? material(n.patch).emission[static_cast<size_t>(c)] : 0.0;
+    }
+    void progress(const std::string& stage, double fraction) const {
+        if (m_opt.progress) m_opt.progress(stage, fraction);
     }
     void refuse_closed_white() const;
-    void build_roots();
-    void initial_links();
+    void build_tree();
+    void endpoints(int node, std::vector<int>& out) const;
+    void children_links(const Link& l, bool split_r, std::vector<Link>& out) const;
+    void self_links(int node, std::vector<Link>& out) const;
+    bool make_link(int r, int s, Link& l, ExactWorkspace& ws, VisibilityStats& st) const;
     void compute_links(std::vector<Link>& links);
-    int split(int node);
-    bool refine();
-    void solve();
+    int split_element(int node);
+    void pull_tables(const std::vector<double>& leaf_value, std::vector<double>& Bn, std::vector<double>& I) const;
+    LinkError link_error(const Link& l, const std::vector<double>& Bn, const std::vector<double>& I) const;
+    bool refine(const std::vector<double>& leaf_bmax);
     void collect_leaves();
-    Eigen::VectorXd apply_G(const Eigen::VectorXd& x, std::vector<double>& Bn, std::vector<double>& Hn) const;
+    void reach();
+    void sort_links();
+    void apply_G(const Eigen::VectorXd& x, Eigen::VectorXd& out, bool correct);
+    void solve();
+    std::vector<double> leaf_guess() const;
 
     const Scene& m_scene;
     HierarchicalOptions m_opt;
     int m_C;
     int m_threads = 1;
     double m_vis_eps = 0;
+    bool m_unblockable = false;
     Hierarchy m_hierarchy;
     ClusterTables m_tables;
     MultiscaleVisibility m_vis;
+
     std::vector<Node> m_nodes;
-    int m_patch_roots = 0;  // nodes [0, patches) are patch roots, then sink roots
+    int m_root = -1;
+    int m_tables_count = 0;
+    std::vector<double> m_sensitivity;  // per cluster table: sum L cos+(n . u(psi_k))
     std::vector<Link> m_links;
-    long m_left_out = 0;              // patches no emitter can reach (no links)
-    std::vector<int> m_leaves;        // patch-tree leaves
-    std::vector<char> m_closed;       // per patch: sees only lit patches (row sum 1)
-    // Per leaf of a closed patch: the row-sum deficit 1 - (own + ancestors'
-    // F), the ancestors' total F and total weight w (0 elsewhere).
-    std::vector<double> m_deficit, m_anc_F, m_anc_w;
-    std::vector<int> m_leaf_index;    // node -> index in m_leaves, -1 otherwise
-    std::vector<std::vector<double>> m_B;  // per channel, per node (pulled)
-    std::vector<std::vector<double>> m_H;  // per channel, per node (pushed: leaves complete)
-    std::vector<double> m_Bmax;       // per node, max over channels
+    std::vector<int32_t> m_link_start;   // CSR by receiver (after sort_links)
+    std::vector<int32_t> m_receivers;
+    std::vector<int> m_leaves;           // element leaves, then sink nodes
+    int m_element_leaves = 0;
+    std::vector<int> m_leaf_index;       // node -> index in m_leaves, -1 otherwise
+    std::vector<char> m_reached;         // per node
+    long m_left_out = 0;
+    // Row sums (see the header): per leaf, the deficit 1 - (sum of what its
+    // own and its ancestors' links deliver for B = 1 everywhere), and the
+    // ancestors' part of that sum; 0 for leaves not known to be closed.
+    std::vector<double> m_deficit, m_anc_sum;
+    std::vector<char> m_closed_patch;
+
+    // Scratch for the operator.
+    std::vector<double> m_Bn, m_I, m_Hn, m_J, m_Ha;
+    // Solution per channel, per node (B pulled, H pushed).
+    std::vector<std::vector<double>> m_B, m_H;
+
     VisibilityStats m_stats;
     double m_ff_time = 0, m_solve_time = 0, m_residual = 0;
     long m_iterations = 0;
+    long m_cluster_links = 0;
 };
 
 void HierarchicalSolver::refuse_closed_white() const {
@@ -215,37 +219,260 @@ void HierarchicalSolver::refuse_closed_white() const {
     }
 }
 
-void HierarchicalSolver::build_roots() {
+// One tree: hierarchy nodes (clusters), then under each hierarchy leaf the
+// sides of its segments (patch roots and sinks). Parents come before their
+// children, so pushes run forwards and pulls backwards over the array.
+void HierarchicalSolver::build_tree() {
+    const auto& hn = m_hierarchy.nodes();
+    std::vector<int32_t> seg_leaf(m_scene.segments.size(), -1);
+    // Patches per segment.
+    std::vector<int> first_patch(m_scene.segments.size(), -1), second_patch(m_scene.segments.size(), -1);
     for (size_t p = 0; p < m_scene.patches.size(); ++p) {
-        Node n;
-        n.seg = m_scene.patch_segment(static_cast<int>(p));
-        n.patch = static_cast<int>(p);
-        n.segment = m_scene.patches[p].segment;
-        n.length = m_scene.patches[p].length;
-        m_nodes.push_back(n);
+        const size_t s = static_cast<size_t>(m_scene.patches[p].segment);
+        (first_patch[s] < 0 ? first_patch[s] : second_patch[s]) = static_cast<int>(p);
     }
-    m_patch_roots = static_cast<int>(m_nodes.size());
-    m_closed.assign(static_cast<size_t>(m_patch_roots), 0);
-    // Unlit sides absorb everything they receive (SPEC): receive-only sinks.
-    for (size_t s = 0; s < m_scene.segments.size(); ++s) {
-        const SceneSegment& ss = m_scene.segments[s];
-        for (int side = 0; side < 2; ++side) {
-            if (side == 0 ? ss.lit_left : ss.lit_right) continue;
-            Node n;
-            n.seg = side == 0 ? ss.seg : ss.seg.reversed();
-            n.segment = static_cast<int>(s);
-            n.length = ss.seg.length();
-            m_nodes.push_back(n);
+    if (hn.empty()) return;
+    // Breadth-first over the hierarchy, children contiguous.
+    struct Pending {
+        int hnode, node;
+    };
+    std::vector<Pending> queue;
+    m_nodes.push_back({});
+    m_root = 0;
+    queue.push_back({m_hierarchy.root(), 0});
+    for (size_t q = 0; q < queue.size(); ++q) {
+        const auto [h, id] = queue[q];
+        const ClusterNode& c = hn[static_cast<size_t>(h)];
+        {
+            Node& n = m_nodes[static_cast<size_t>(id)];
+            n.kind = Kind::Cluster;
+            n.hnode = h;
+            n.center = c.box.center();
+            n.radius = 0.5 * c.box.diagonal();
+        }
+        if (!c.leaf()) {
+            const int first = static_cast<int>(m_nodes.size());
+            m_nodes[static_cast<size_t>(id)].child = first;
+            m_nodes[static_cast<size_t>(id)].nchild = 2;
+            for (int k = 0; k < 2; ++k) {
+                Node child;
+                child.parent = id;
+                m_nodes.push_back(child);
+                queue.push_back({c.child[k], first + k});
+            }
+            continue;
+        }
+        // A leaf: its segments' two sides each.
+        m_nodes[static_cast<size_t>(id)].leaf_cluster = true;
+        const int first = static_cast<int>(m_nodes.size());
+        for (int32_t k = c.first; k < c.first + c.count; ++k) {
+            const int s = m_hierarchy.order()[static_cast<size_t>(k)];
+            seg_leaf[static_cast<size_t>(s)] = h;
+            const SceneSegment& ss = m_scene.segments[static_cast<size_t>(s)];
+            for (int side = 0; side < 2; ++side) {
+                const bool lit = side == 0 ? ss.lit_left : ss.lit_right;
+                Node n;
+                n.parent = id;
+                n.hnode = h;
+                n.segment = s;
+                n.seg = side == 0 ? ss.seg : ss.seg.reversed();
+                n.normal = n.seg.left_normal();
+                n.center = n.seg.midpoint();
+                n.length = ss.seg.length();
+                n.radius = 0.5 * n.length;
+                if (lit) {
+                    n.kind = Kind::Element;
+                    const int p = (first_patch[static_cast<size_t>(s)] >= 0 &&
+                                   m_scene.patches[static_cast<size_t>(first_patch[static_cast<size_t>(s)])].lit_left == (side == 0))
+                                      ? first_patch[static_cast<size_t>(s)]
+                                      : second_patch[static_cast<size_t>(s)];
+                    n.patch = p;
+                } else {
+                    n.kind = Kind::Sink;
+                }
+                m_nodes.push_back(n);
+            }
+        }
+        m_nodes[static_cast<size_t>(id)].child = first;
+        m_nodes[static_cast<size_t>(id)].nchild = static_cast<int>(m_nodes.size()) - first;
+    }
+    // Directional tables for the clusters that are not hierarchy leaves
+    // (links never end at a leaf cluster: at that level they go to the sides).
+    for (Node& n : m_nodes)
+        if (n.cluster() && !n.leaf_cluster) n.table = m_tables_count++;
+    m_sensitivity.assign(static_cast<size_t>(m_tables_count) * K, 0.0);
+    // can_send and sensitivity, children before parents.
+    for (size_t k = m_nodes.size(); k-- > 0;) {
+        Node& n = m_nodes[k];
+        if (n.kind == Kind::Element) {
+            bool any = false;
+            for (int c = 0; c < m_C; ++c) any = any || rho(static_cast<int>(k), c) > 0 || emission(static_cast<int>(k), c) > 0;
+            n.can_send = any;
+        }
+        if (n.parent < 0) continue;
+        Node& p = m_nodes[static_cast<size_t>(n.parent)];
+        p.can_send = p.can_send || n.can_send;
+        if (p.table >= 0) {
+            double* dst = &m_sensitivity[static_cast<size_t>(p.table) * K];
+            if (n.table >= 0) {
+                const double* src = &m_sensitivity[static_cast<size_t>(n.table) * K];
+                for (int b = 0; b < K; ++b) dst[b] += src[b];
+            } else if (n.leaf_cluster) {
+                for (int c = n.child; c < n.child + n.nchild; ++c)
+                    add_cosine_lobe(dst, m_nodes[static_cast<size_t>(c)].normal, m_nodes[static_cast<size_t>(c)].length);
+            }
         }
     }
 }
 
-// F for each link (both must be set: r, s), dropping the ones that do not see
-// each other. An empty shaft costs crossed strings only (in the visibility
-// module; counted there as `unoccluded`).
+// The nodes a link to `node` really goes to: a hierarchy leaf stands for
+// its sides.
+void HierarchicalSolver::endpoints(int node, std::vector<int>& out) const {
+    const Node& n = m_nodes[static_cast<size_t>(node)];
+    if (n.leaf_cluster)
+        for (int c = n.child; c < n.child + n.nchild; ++c) out.push_back(c);
+    else
+        out.push_back(node);
+}
+
+// The links that replace a cluster's self link: every ordered pair of its
+// children's endpoints, and the self links of child clusters.
+void HierarchicalSolver::self_links(int node, std::vector<Link>& out) const {
+    std::vector<int> ends;
+    const Node& n = m_nodes[static_cast<size_t>(node)];
+    if (n.leaf_cluster)
+        endpoints(node, ends);
+    else
+        for (int c = n.child; c < n.child + n.nchild; ++c) endpoints(c, ends);
+    for (int a : ends)
+        for (int b : ends) {
+            const Node& na = m_nodes[static_cast<size_t>(a)];
+            const Node& nb = m_nodes[static_cast<size_t>(b)];
+            if (a == b) {
+                if (na.cluster()) out.push_back(link_between(a, a));
+                continue;
+            }
+            if (!nb.can_send || (!na.cluster() && !nb.cluster() && na.segment == nb.segment)) continue;
+            Link l;
+            l.r = a;
+            l.s = b;
+            out.push_back(l);
+        }
+}
+
+// Children links of l, splitting the receiver (split_r) or the sender.
+void HierarchicalSolver::children_links(const Link& l, bool split_r, std::vector<Link>& out) const {
+    const int node = split_r ? l.r : l.s;
+    const Node& n = m_nodes[static_cast<size_t>(node)];
+    std::vector<int> ends;
+    for (int c = n.child; c < n.child + n.nchild; ++c) endpoints(c, ends);
+    for (int e : ends) {
+        Link k;
+        k.r = split_r ? e : l.r;
+        k.s = split_r ? l.s : e;
+        const Node& nr = m_nodes[static_cast<size_t>(k.r)];
+        const Node& ns = m_nodes[static_cast<size_t>(k.s)];
+        if (!ns.can_send || ns.sink()) continue;
+        if (!nr.cluster() && !ns.cluster() && nr.segment == ns.segment) continue;
+        out.push_back(k);
+    }
+}
+
+// Fills l's coefficient and estimates; false when r and s cannot exchange.
+bool HierarchicalSolver::make_link(int r, int s, Link& l, ExactWorkspace& ws, VisibilityStats& st) const {
+    const Node& nr = m_nodes[static_cast<size_t>(r)];
+    const Node& ns = m_nodes[static_cast<size_t>(s)];
+    if (r == s) return true;  // a cluster's self link: always split, carries nothing itself
+    if (!nr.cluster() && !ns.cluster()) {
+        const double Fu = form_factor_unoccluded(nr.seg, ns.seg);
+        if (!(Fu > 0)) {
+            ++st.culled;
+            return false;
+        }
+        double F = Fu, err = 0;
+        if (!m_unblockable) {
+            const MultiscaleResult m = m_vis.form_factor(nr.seg, ns.seg, nr.segment, ns.segment, m_vis_eps,
+                                                         GammaRule::Bound, ws, st);
+            F = m.F;
+            err = m.error_bound;
+        } else {
+            ++st.unoccluded;
+        }
+        if (!(F > 0) && err == 0) return false;
+        l.coef = F;
+        l.Fu = static_cast<float>(Fu);
+        l.tau = static_cast<float>(F / Fu);
+        l.vis_err = static_cast<float>(err);
+        return true;
+    }
+    // Cluster links: point approximations at the centres.
+    const Vec2 d = nr.center - ns.center;
+    const double dist = norm(d);
+    const double reach = nr.radius + ns.radius;
+    // A side of an element whose line cuts the other node's box cannot be
+    // treated as a point source or a point receiver.
+    auto straddles = [&](const Node& e, const Node& c) {
+        if (e.cluster() || !c.cluster()) return false;
+        const Box& b = m_hierarchy.node(c.hnode).box;
+        double lo = 1e300, hi = -1e300;
+        for (Vec2 p : {b.lo, b.hi, Vec2{b.lo.x, b.hi.y}, Vec2{b.hi.x, b.lo.y}}) {
+            const double o = dot(p - e.seg.a, e.normal);
+            lo = std::min(lo, o);
+            hi = std::max(hi, o);
+        }
+        return lo < 0 && hi > 0;
+    };
+    // Facing: an element must have the other node's box in front of it.
+    auto in_front = [&](const Node& e, const Node& c) {
+        if (e.cluster()) return true;
+        const Box& b = c.cluster() ? m_hierarchy.node(c.hnode).box : Box{};
+        if (!c.cluster()) return true;
+        for (Vec2 p : {b.lo, b.hi, Vec2{b.lo.x, b.hi.y}, Vec2{b.hi.x, b.lo.y}})
+            if (dot(p - e.seg.a, e.normal) > 0) return true;
+        return false;
+    };
+    if (!in_front(nr, ns) || !in_front(ns, nr)) {
+        ++st.culled;
+        return false;
+    }
+    if (!(dist > reach) || straddles(nr, ns) || straddles(ns, nr)) {
+        l.unresolved = true;
+        l.coef = 0;
+        return true;
+    }
+    const Vec2 u = d / dist;  // from s to r
+    l.sbin = bin_of(u);
+    l.rbin = bin_of(-u);
+    l.geo = static_cast<float>(2 * reach / dist);
+    double tau = 1, terr = 0;
+    if (!m_unblockable) {
+        const TransmittanceResult t = m_vis.transmittance(nr.hnode, ns.hnode, m_vis_eps, GammaRule::Bound, ws, st);
+        tau = t.tau;
+        terr = t.error_bound;
+    } else {
+        ++st.unoccluded;
+    }
+    if (!(tau > 0) && terr == 0) return false;
+    l.tau = static_cast<float>(tau);
+    l.vis_err = static_cast<float>(terr);
+    if (!nr.cluster()) {
+        // Angle r subtends from the sender's centre (only its part in front).
+        const Vec2 a = nr.seg.a - ns.center, b = nr.seg.b - ns.center;
+        const double delta = std::abs(std::atan2(cross(a, b), dot(a, b)));
+        l.coef = tau * delta / nr.length;
+    } else if (!ns.cluster()) {
+        const double c = std::max(0.0, dot(ns.normal, u));
+        l.coef = tau / dist * 0.5 * ns.length * c;
+    } else {
+        l.coef = tau / dist;
+    }
+    return true;
+}
+
 void HierarchicalSolver::compute_links(std::vector<Link>& links) {
     const auto t0 = Clock::now();
     const long n = static_cast<long>(links.size());
+    std::vector<char> keep(links.size(), 1);
 #pragma omp parallel num_threads(m_threads)
     {
         ExactWorkspace ws;
@@ -253,109 +480,20 @@ void HierarchicalSolver::compute_links(std::vector<Link>& links) {
 #pragma omp for schedule(dynamic, 16)
         for (long k = 0; k < n; ++k) {
             Link& l = links[static_cast<size_t>(k)];
-            const Node& r = m_nodes[static_cast<size_t>(l.r)];
-            const Node& s = m_nodes[static_cast<size_t>(l.s)];
-            l.Fu = form_factor_unoccluded(r.seg, s.seg);
-            if (!(l.Fu > 0)) {
-                ++local.culled;
-                l.F = 0;
-                continue;
-            }
-            const MultiscaleResult m =
-                m_vis.form_factor(r.seg, s.seg, r.segment, s.segment, m_vis_eps, GammaRule::Bound, ws, local);
-            l.F = m.F;
-            l.vis_err = m.error_bound;
-            if (!r.sink()) {
-                double rv = 0;
-                for (int q = 0; q < 4; ++q) {
-                    const Segment rq{lerp(r.seg.a, r.seg.b, q / 4.0), lerp(r.seg.a, r.seg.b, (q + 1) / 4.0)};
-                    rv += 0.25 * std::abs(form_factor_unoccluded(rq, s.seg) - l.Fu);
-                }
-                l.w = r.length * (rv + std::max(0.0, std::min(l.F, l.Fu - l.F)));
-            }
+            keep[static_cast<size_t>(k)] = make_link(l.r, l.s, l, ws, local) ? 1 : 0;
         }
 #pragma omp critical
         m_stats += local;
     }
-    links.erase(std::remove_if(links.begin(), links.end(), [](const Link& l) { return !(l.F > 0); }), links.end());
+    size_t w = 0;
+    for (size_t k = 0; k < links.size(); ++k)
+        if (keep[k]) links[w++] = links[k];
+    links.resize(w);
     m_ff_time += seconds_since(t0);
 }
 
-void HierarchicalSolver::initial_links() {
-    std::vector<Link> links;
-    const int P = m_patch_roots, N = static_cast<int>(m_nodes.size());
-    for (int r = 0; r < N; ++r)
-        for (int s = 0; s < P; ++s) {
-            if (m_nodes[static_cast<size_t>(r)].segment == m_nodes[static_cast<size_t>(s)].segment) continue;
-            if (!clip_to_lit_halfplanes(m_nodes[static_cast<size_t>(r)].seg, m_nodes[static_cast<size_t>(s)].seg)) continue;
-            links.push_back({r, s});
-        }
-    compute_links(links);
-    // Pay only for what can be lit (solver/reachability.h): patches joined
-    // by a link that may carry light (F, or its visibility bound, above 0)
-    // exchange both ways; a link whose sender no emitter can reach carries
-    // nothing, ever. Such links live only among unreached patches, so
-    // dropping them leaves every reached patch's links as they were.
-    // A pair whose approximate F cannot be told from 0 (F within its
-    // visibility bound) is settled by the exact exchange.
-    std::vector<std::pair<int, int>> exchanging;
-    const ExactVisibility exact(m_hierarchy);
-    ExactWorkspace ws;
-    for (const Link& l : links) {
-        if (l.r >= P || l.r > l.s) continue;
-        // Grazing corners leave form factors of rounding size (1e-33 seen);
-        // below 64 ulps a pair is taken as dark: it could carry at most that
-        // fraction of its light.
-        constexpr double noise = 64 * std::numeric_limits<double>::epsilon();
-        bool carries = l.F > l.vis_err + noise;
-        if (!carries && l.F + l.vis_err > noise) {
-            const Node& nr = m_nodes[static_cast<size_t>(l.r)];
-            const Node& ns = m_nodes[static_cast<size_t>(l.s)];
-            carries = exact.exchange(nr.seg, ns.seg, nr.segment, ns.segment, ws, m_stats) >
-                      noise * std::min(nr.length, ns.length);
-        }
-        if (carries) exchanging.push_back({l.r, l.s});
-    }
-    std::vector<char> emits(static_cast<size_t>(P), 0);
-    for (int p = 0; p < P; ++p)
-        for (int c = 0; c < m_C; ++c) emits[static_cast<size_t>(p)] = emits[static_cast<size_t>(p)] || emission(p, c) > 0;
-    const std::vector<char> reached = reachable_patches(P, exchanging, emits);
-    m_left_out = 0;
-    for (int p = 0; p < P; ++p) m_left_out += reached[static_cast<size_t>(p)] ? 0 : 1;
-    // Drop links from unreached senders, and links into unreached patches
-    // (only rounding-level F can join the two: they would carry noise).
-    links.erase(std::remove_if(links.begin(), links.end(),
-                               [&](const Link& l) {
-                                   return !reached[static_cast<size_t>(l.s)] ||
-                                          (l.r < P && !reached[static_cast<size_t>(l.r)]);
-                               }),
-                links.end());
-    m_links = std::move(links);
-    // A patch whose links to lit patches sum to 1 sees nothing else (no
-    // sink, no escape) at any of its points: the escape fraction and the
-    // form factor to sinks are >= 0 pointwise and average to 0 over it.
-    std::vector<double> sum(static_cast<size_t>(P), 0.0), bound(static_cast<size_t>(P), closure_tolerance);
-    std::vector<char> sees_sink(static_cast<size_t>(P), 0);
-    for (const Link& l : m_links) {
-        if (m_nodes[static_cast<size_t>(l.r)].sink()) {
-            // Reciprocity: s sees the sink with F_sr = L_r F_rs / L_s. Below
-            // closure_tolerance (beyond the visibility bound) it is rounding:
-            // grazing lines through a closed shape's shared vertices.
-            const double ratio = m_nodes[static_cast<size_t>(l.r)].length / m_nodes[static_cast<size_t>(l.s)].length;
-            if (ratio * (l.F - l.vis_err) > closure_tolerance) sees_sink[static_cast<size_t>(l.s)] = 1;
-            continue;
-        }
-        sum[static_cast<size_t>(l.r)] += l.F;
-        bound[static_cast<size_t>(l.r)] += l.vis_err;
-    }
-    m_closed.assign(static_cast<size_t>(P), 0);
-    for (int p = 0; p < P; ++p)
-        m_closed[static_cast<size_t>(p)] =
-            !sees_sink[static_cast<size_t>(p)] && std::abs(1 - sum[static_cast<size_t>(p)]) <= bound[static_cast<size_t>(p)];
-}
-
-// Creates the two children of `node` if it has none; returns the first.
-int HierarchicalSolver::split(int node) {
+// Creates the two halves of element `node` if it has none; returns the first.
+int HierarchicalSolver::split_element(int node) {
     if (m_nodes[static_cast<size_t>(node)].child >= 0) return m_nodes[static_cast<size_t>(node)].child;
     const Node parent = m_nodes[static_cast<size_t>(node)];
     const int first = static_cast<int>(m_nodes.size());
@@ -366,34 +504,216 @@ int HierarchicalSolver::split(int node) {
         c.s0 = k == 0 ? parent.s0 : 0.5 * (parent.s0 + parent.s1);
         c.s1 = k == 0 ? 0.5 * (parent.s0 + parent.s1) : parent.s1;
         c.length = 0.5 * parent.length;
+        c.radius = 0.5 * c.length;
+        c.center = c.seg.midpoint();
         c.child = -1;
+        c.nchild = 0;
         c.parent = node;
-        c.depth = parent.depth + 1;
+        c.depth = static_cast<int16_t>(parent.depth + 1);
         m_nodes.push_back(c);
-        for (int ch = 0; ch < m_C; ++ch) {
-            m_B[static_cast<size_t>(ch)].push_back(m_B[static_cast<size_t>(ch)][static_cast<size_t>(node)]);
-            m_H[static_cast<size_t>(ch)].push_back(m_H[static_cast<size_t>(ch)][static_cast<size_t>(node)]);
-        }
-        m_Bmax.push_back(m_Bmax[static_cast<size_t>(node)]);
+        for (auto& B : m_B) B.push_back(B[static_cast<size_t>(node)]);
+        for (auto& H : m_H) H.push_back(H[static_cast<size_t>(node)]);
     }
     m_nodes[static_cast<size_t>(node)].child = first;
+    m_nodes[static_cast<size_t>(node)].nchild = 2;
     return first;
 }
 
-// One refinement round with the current solution: returns whether a link split.
-bool HierarchicalSolver::refine() {
+// Pull: per node the length-weighted mean of `leaf_value` over element
+// leaves (Bn), per cluster table the exitance I(phi_k).
+void HierarchicalSolver::pull_tables(const std::vector<double>& leaf_value, std::vector<double>& Bn,
+                                     std::vector<double>& I) const {
+    const size_t N = m_nodes.size();
+    Bn.assign(N, 0.0);
+    I.assign(static_cast<size_t>(m_tables_count) * K, 0.0);
+    for (size_t k = N; k-- > 0;) {
+        const Node& n = m_nodes[k];
+        if (n.kind == Kind::Element) {
+            if (n.child < 0) {
+                const int i = m_leaf_index[k];
+                Bn[k] = i >= 0 ? leaf_value[static_cast<size_t>(i)] : 0.0;
+            } else {
+                const size_t a = static_cast<size_t>(n.child);
+                Bn[k] = 0.5 * (Bn[a] + Bn[a + 1]);  // halves of equal length
+            }
+        }
+        if (n.parent < 0) continue;
+        const Node& p = m_nodes[static_cast<size_t>(n.parent)];
+        if (p.table < 0) continue;
+        double* dst = &I[static_cast<size_t>(p.table) * K];
+        if (n.table >= 0) {
+            const double* src = &I[static_cast<size_t>(n.table) * K];
+            for (int b = 0; b < K; ++b) dst[b] += src[b];
+        } else if (n.leaf_cluster) {
+            for (int c = n.child; c < n.child + n.nchild; ++c) {
+                const Node& side = m_nodes[static_cast<size_t>(c)];
+                if (side.kind != Kind::Element) continue;
+                const double w = 0.5 * side.length * Bn[static_cast<size_t>(c)];
+                if (w != 0) add_cosine_lobe(dst, side.normal, w);
+            }
+        }
+    }
+}
+
+// Estimated error in the power the link transports, with the sender values
+// of the current solution (Bn per node, I per cluster table), and which
+// side's approximations make most of it (split_r: the receiver's).
+LinkError HierarchicalSolver::link_error(const Link& l, const std::vector<double>& Bn,
+                                         const std::vector<double>& I) const {
+    const Node& r = m_nodes[static_cast<size_t>(l.r)];
+    const Node& s = m_nodes[static_cast<size_t>(l.s)];
+    constexpr double inf = std::numeric_limits<double>::infinity();
+    const double size_r = r.cluster() ? 2 * r.radius : r.length;
+    const double size_s = s.cluster() ? 2 * s.radius : s.length;
+    if (l.r == l.s) return {inf, true};
+    if (!r.cluster() && !s.cluster()) {
+        const double power = Bn[static_cast<size_t>(l.s)] * r.length;
+        if (!(power > 0)) return {};
+        // Kernel variation over quarters of each side: catches ends-vs-
+        // middle variation that halves miss by symmetry.
+        double rv = 0, sv = 0;
+        for (int q = 0; q < 4; ++q) {
+            const Segment sq{lerp(s.seg.a, s.seg.b, q / 4.0), lerp(s.seg.a, s.seg.b, (q + 1) / 4.0)};
+            sv += std::abs(form_factor_unoccluded(r.seg, sq) - 0.25 * l.Fu);
+            if (!r.sink()) {
+                const Segment rq{lerp(r.seg.a, r.seg.b, q / 4.0), lerp(r.seg.a, r.seg.b, (q + 1) / 4.0)};
+                rv += 0.25 * std::abs(form_factor_unoccluded(rq, s.seg) - l.Fu);
+            }
+        }
+        // A partly hidden sender may put a shadow boundary anywhere.
+        const double occlusion = std::max(0.0, std::min<double>(l.coef, l.Fu - l.coef));
+        double err = power * (std::max(rv, sv) + occlusion + l.vis_err);
+        // The link spreads the sender's mean, not its halves' values.
+        if (s.child >= 0) {
+            const size_t a = static_cast<size_t>(s.child);
+            err += r.length * l.coef * 0.5 * std::abs(Bn[a] - Bn[a + 1]);
+        }
+        return {err, size_r >= size_s};
+    }
+    // Cluster links: the power carried, unoccluded, and its uncertainty.
+    double v = 0, v_err = 0;
+    if (s.cluster()) {
+        const double* t = &I[static_cast<size_t>(s.table) * K];
+        v = interpolate(t, l.sbin);
+        v_err = interpolation_error(t, l.sbin);
+    } else {
+        v = Bn[static_cast<size_t>(l.s)];
+    }
+    if (l.unresolved) {
+        // Overlapping nodes: no point approximation holds; split the larger
+        // if the sender sends anything at all.
+        double sent = v;
+        if (s.cluster()) {
+            const double* t = &I[static_cast<size_t>(s.table) * K];
+            sent = *std::max_element(t, t + K);
+        }
+        return sent > 0 ? LinkError{inf, size_r >= size_s} : LinkError{};
+    }
+    if (!(v > 0)) return {};
+    double sens = r.length, sens_err = 0;
+    if (r.cluster()) {
+        const double* t = &m_sensitivity[static_cast<size_t>(r.table) * K];
+        sens = interpolate(t, l.rbin);
+        sens_err = interpolation_error(t, l.rbin);
+    }
+    const double dist = norm(r.center - s.center);
+    const double tau = l.tau;
+    const double coef_u = tau > 0 ? l.coef / tau : 0;  // unoccluded coefficient
+    double unocc = 0;
+    if (coef_u > 0) {
+        unocc = coef_u * v * sens;
+    } else {
+        // Fully blocked but uncertain: bound with the unoccluded coefficient.
+        unocc = r.cluster() ? v * sens / dist : v * r.length / dist;
+    }
+    // Relative errors by side:
+    //  - point approximation: a node of radius rho seen from distance d
+    //    changes direction and distance by ~rho / d over its extent (twice
+    //    that for the cosines at both ends); an element receiver's angle is
+    //    exact, only the sender's exitance varies over it (rho_r / d);
+    //  - the tables' interpolation (directional model);
+    //  - occlusion inside a cluster: the tables count every element facing
+    //    the link's direction, also those hidden behind others of the same
+    //    cluster. Sensitivity N(psi) = sum L cos+ beyond the box's own width
+    //    across psi is surely hidden (more than one layer deep); that share
+    //    of the power is misplaced (an estimate, not a bound: layers that fit
+    //    in the width may hide each other too).
+    const Vec2 u = (r.center - s.center) / dist;
+    auto layered = [&](const Node& c, BinWeight b) {
+        const double n = interpolate(&m_sensitivity[static_cast<size_t>(c.table) * K], b);
+        const Vec2 e = m_hierarchy.node(c.hnode).box.extent();
+        const double width = std::abs(e.x * u.y) + std::abs(e.y * u.x);
+        return n > 0 ? std::max(0.0, 1 - width / n) : 0.0;
+    };
+    double rel_r = 0, rel_s = 0;
+    if (r.cluster())
+        rel_r = 2 * r.radius / dist + layered(r, l.rbin) + (sens > 0 ? sens_err / sens : 0);
+    else
+        rel_r = r.radius / dist;
+    if (s.cluster())
+        rel_s = 2 * s.radius / dist + layered(s, l.sbin) + v_err / v;
+    else
+        rel_s = 2 * s.radius / dist;
+    // Visibility: a partly hidden link may put a shadow boundary anywhere,
+    // and the transmittance is known to its bound. Splitting the larger
+    // side narrows the shaft most.
+    const double vis = std::min(tau, 1 - tau) + l.vis_err;
+    const double err = unocc * (rel_r + rel_s + vis);
+    const bool split_r = rel_r + (size_r >= size_s ? vis : 0) >= rel_s + (size_r < size_s ? vis : 0);
+    return {err, split_r};
+}
+
+std::vector<double> HierarchicalSolver::leaf_guess() const {
+    // Before any solve: every patch at E + rho B_bar, B_bar the radiosity of
+    // a closed room with the scene's emission and absorption (a guess that
+    // errs high in open scenes, so refinement errs fine).
+    CompensatedSum em, ab;
+    for (size_t i = 0; i < static_cast<size_t>(m_element_leaves); ++i) {
+        const int node = m_leaves[i];
+        double e = 0, a = 0;
+        for (int c = 0; c < m_C; ++c) {
+            e = std::max(e, emission(node, c));
+            a = std::max(a, 1 - rho(node, c));
+        }
+        em.add(m_nodes[static_cast<size_t>(node)].length * e);
+        ab.add(m_nodes[static_cast<size_t>(node)].length * a);
+    }
+    const double bbar = ab.value() > 0 ? em.value() / ab.value() : 0;
+    std::vector<double> g(static_cast<size_t>(m_element_leaves));
+    for (size_t i = 0; i < g.size(); ++i) {
+        const int node = m_leaves[i];
+        double b = 0;
+        for (int c = 0; c < m_C; ++c) b = std::max(b, emission(node, c) + rho(node, c) * bbar);
+        g[i] = b;
+    }
+    return g;
+}
+
+// One refinement round against leaf values `leaf_bmax` (max over channels);
+// returns whether a link split.
+bool HierarchicalSolver::refine(const std::vector<double>& leaf_bmax) {
+    std::vector<double> Bn, I;
+    pull_tables(leaf_bmax, Bn, I);
     // eps_abs = eps * W / N (see the header).
     CompensatedSum W;
-    for (int p = 0; p < m_patch_roots; ++p) W.add(m_nodes[static_cast<size_t>(p)].length * m_Bmax[static_cast<size_t>(p)]);
-    const double eps_abs = m_opt.eps * W.value() / std::max(1, m_patch_roots);
+    long patches = 0;
+    for (size_t k = 0; k < m_nodes.size(); ++k) {
+        const Node& n = m_nodes[k];
+        if (n.kind == Kind::Element && n.depth == 0) {
+            W.add(n.length * Bn[k]);
+            ++patches;
+        }
+    }
+    const double eps_abs = m_opt.eps * W.value() / std::max(1L, patches);
     if (!(eps_abs > 0)) return false;
 
     std::vector<int> work(m_links.size());
     for (size_t k = 0; k < work.size(); ++k) work[k] = static_cast<int>(k);
     bool any = false;
     std::vector<char> decision;
+    std::vector<char> dead(m_links.size(), 0);
     while (!work.empty()) {
-        // 1. Decide (in parallel; only cheap unoccluded form factors).
+        // 1. Decide, in parallel.
         decision.assign(work.size(), 0);
         const long nw = static_cast<long>(work.size());
 #pragma omp parallel for num_threads(m_threads) schedule(dynamic, 64)
@@ -401,71 +721,52 @@ bool HierarchicalSolver::refine() {
             const Link& l = m_links[static_cast<size_t>(work[static_cast<size_t>(k)])];
             const Node& r = m_nodes[static_cast<size_t>(l.r)];
             const Node& s = m_nodes[static_cast<size_t>(l.s)];
-            const bool can_r = !r.sink() && r.depth < m_opt.max_depth;
-            const bool can_s = s.depth < m_opt.max_depth;
+            if (l.r == l.s) {
+                decision[static_cast<size_t>(k)] = 3;
+                continue;
+            }
+            const bool can_r = r.cluster() || (r.kind == Kind::Element && r.depth < m_opt.max_depth);
+            const bool can_s = s.cluster() || (s.kind == Kind::Element && s.depth < m_opt.max_depth);
             if (!can_r && !can_s) continue;
-            // All received power matters: rho of it for B, 1 - rho for the
-            // absorbed totals (a black lamp's B is its E, but what it absorbs
-            // is part of the balance).
-            const double power = m_Bmax[static_cast<size_t>(l.s)] * r.length;
-            if (!(power > 0)) continue;
-            // Kernel variation over quarters of each side.
-            double rv = 0, sv = 0;
-            for (int q = 0; q < 4; ++q) {
-                const Segment sq{lerp(s.seg.a, s.seg.b, q / 4.0), lerp(s.seg.a, s.seg.b, (q + 1) / 4.0)};
-                sv += std::abs(form_factor_unoccluded(r.seg, sq) - 0.25 * l.Fu);
-                if (!r.sink()) {
-                    const Segment rq{lerp(r.seg.a, r.seg.b, q / 4.0), lerp(r.seg.a, r.seg.b, (q + 1) / 4.0)};
-                    rv += 0.25 * std::abs(form_factor_unoccluded(rq, s.seg) - l.Fu);
-                }
-            }
-            const double occlusion = std::max(0.0, std::min(l.F, l.Fu - l.F));
-            double err = power * (std::max(rv, sv) + occlusion + l.vis_err);
-            // The sender's own unevenness, where other links already split it:
-            // the link spreads B_s's mean, not its halves' values.
-            if (s.child >= 0) {
-                const size_t a = static_cast<size_t>(s.child);
-                double dB = 0;
-                for (int c = 0; c < m_C; ++c)
-                    dB = std::max(dB, std::abs(m_B[static_cast<size_t>(c)][a] - m_B[static_cast<size_t>(c)][a + 1]));
-                err += r.length * l.F * 0.5 * dB;
-            }
-            if (err <= eps_abs) continue;
-            const bool split_r = can_r && (!can_s || r.length >= s.length);
+            const LinkError e = link_error(l, Bn, I);
+            if (e.err <= eps_abs) continue;
+            const bool split_r = can_r && (!can_s || e.split_r);
             decision[static_cast<size_t>(k)] = split_r ? 1 : 2;
         }
         // 2. Split (serially: creates nodes), collecting the children links.
         std::vector<Link> fresh;
-        std::vector<char> dead(m_links.size(), 0);
         for (size_t k = 0; k < work.size(); ++k) {
             if (!decision[k]) continue;
             const Link l = m_links[static_cast<size_t>(work[k])];
             dead[static_cast<size_t>(work[k])] = 1;
             any = true;
-            if (decision[k] == 1) {
-                const int c = split(l.r);
-                fresh.push_back({c, l.s});
-                fresh.push_back({c + 1, l.s});
-            } else {
-                const int c = split(l.s);
-                fresh.push_back({l.r, c});
-                fresh.push_back({l.r, c + 1});
+            if (decision[k] == 3) {
+                self_links(l.r, fresh);
+                continue;
             }
+            const bool split_r = decision[k] == 1;
+            const int node = split_r ? l.r : l.s;
+            if (m_nodes[static_cast<size_t>(node)].kind == Kind::Element) {
+                split_element(node);
+                while (Bn.size() < m_nodes.size()) Bn.push_back(Bn[static_cast<size_t>(node)]);  // halves start at the mean
+            }
+            children_links(l, split_r, fresh);
         }
         if (fresh.empty()) break;
-        // 3. Form factors of the new links (in parallel), then swap them in.
+        // 3. Coefficients of the new links (in parallel), then append them.
         compute_links(fresh);
-        std::vector<Link> kept;
-        kept.reserve(m_links.size() + fresh.size());
-        for (size_t k = 0; k < m_links.size(); ++k)
-            if (!dead[k]) kept.push_back(m_links[k]);
         work.clear();
         for (const Link& l : fresh) {
-            work.push_back(static_cast<int>(kept.size()));
-            kept.push_back(l);
+            work.push_back(static_cast<int>(m_links.size()));
+            m_links.push_back(l);
+            dead.push_back(0);
         }
-        m_links = std::move(kept);
+        progress(fmt::format("refining: {} links", m_links.size()), -1);
     }
+    size_t w = 0;
+    for (size_t k = 0; k < m_links.size(); ++k)
+        if (!dead[k]) m_links[w++] = m_links[k];
+    m_links.resize(w);
     return any;
 }
 
@@ -473,111 +774,188 @@ void HierarchicalSolver::collect_leaves() {
     m_leaves.clear();
     m_leaf_index.assign(m_nodes.size(), -1);
     for (size_t k = 0; k < m_nodes.size(); ++k)
-        if (!m_nodes[k].sink() && m_nodes[k].child < 0) {
+        if (m_nodes[k].kind == Kind::Element && m_nodes[k].child < 0) {
             m_leaf_index[k] = static_cast<int>(m_leaves.size());
             m_leaves.push_back(static_cast<int>(k));
         }
-    // Row sums per leaf: its own links' F (exact averages over the leaf) and
-    // its ancestors' (averages over larger pieces: the refinement error).
-    std::vector<double> own(m_nodes.size(), 0.0), anc(m_nodes.size(), 0.0);
-    std::vector<double> own_w(m_nodes.size(), 0.0), anc_w(m_nodes.size(), 0.0);
-    for (const Link& l : m_links) {
-        own[static_cast<size_t>(l.r)] += l.F;
-        own_w[static_cast<size_t>(l.r)] += l.w;
-    }
-    for (size_t k = 0; k < m_nodes.size(); ++k)
-        if (m_nodes[k].parent >= 0) {
-            const size_t q = static_cast<size_t>(m_nodes[k].parent);
-            anc[k] = anc[q] + own[q];
-            anc_w[k] = anc_w[q] + own_w[q];
-        }
-    m_deficit.assign(m_leaves.size(), 0.0);
-    m_anc_F.assign(m_leaves.size(), 0.0);
-    m_anc_w.assign(m_leaves.size(), 0.0);
-    for (size_t i = 0; i < m_leaves.size(); ++i) {
-        const size_t k = static_cast<size_t>(m_leaves[i]);
-        if (!m_closed[static_cast<size_t>(m_nodes[k].patch)]) continue;
-        m_deficit[i] = 1 - own[k] - anc[k];
-        m_anc_F[i] = anc[k];
-        m_anc_w[i] = anc_w[k];
-    }
+    m_element_leaves = static_cast<int>(m_leaves.size());
 }
 
-// G(x): pull the leaf radiosities x up the trees, gather along the links,
-// push the irradiance down to the leaves. Bn, Hn receive the per-node values.
-Eigen::VectorXd HierarchicalSolver::apply_G(const Eigen::VectorXd& x, std::vector<double>& Bn,
-                                            std::vector<double>& Hn) const {
+// Groups links by receiver (CSR) so that the gather runs in parallel over
+// receivers without races.
+void HierarchicalSolver::sort_links() {
+    std::sort(m_links.begin(), m_links.end(), [](const Link& a, const Link& b) { return a.r < b.r || (a.r == b.r && a.s < b.s); });
+    m_receivers.clear();
+    m_link_start.clear();
+    for (size_t k = 0; k < m_links.size(); ++k)
+        if (k == 0 || m_links[k].r != m_links[k - 1].r) {
+            m_receivers.push_back(m_links[k].r);
+            m_link_start.push_back(static_cast<int32_t>(k));
+        }
+    m_link_start.push_back(static_cast<int32_t>(m_links.size()));
+    m_cluster_links = 0;
+    for (const Link& l : m_links)
+        if (m_nodes[static_cast<size_t>(l.r)].cluster() || m_nodes[static_cast<size_t>(l.s)].cluster()) ++m_cluster_links;
+}
+
+// Light flow (solver/reachability.h): which element leaves and sinks any
+// emitter's light can reach along pulls (leaf -> ancestors), links (sender
+// -> receiver) and pushes (node -> descendants). Links whose sender is not
+// reached carry nothing and are dropped.
+void HierarchicalSolver::reach() {
+    const int N = static_cast<int>(m_nodes.size());
+    std::vector<char> sources(static_cast<size_t>(N), 0);
+    for (int k = 0; k < N; ++k)
+        for (int c = 0; c < m_C; ++c) sources[static_cast<size_t>(k)] = sources[static_cast<size_t>(k)] || emission(k, c) > 0;
+    // Light climbs (pull) only into a sender, and comes down (push) only
+    // from what a receiver got, so every node has two vertices: k receiving
+    // (reached by a link or a push) and N + k sending (reached by a pull);
+    // only links lead from a sending vertex to a receiving one.
+    std::vector<std::pair<int, int>> flow;
+    flow.reserve(3 * m_nodes.size() + m_links.size());
+    for (int k = 0; k < N; ++k) {
+        const Node& n = m_nodes[static_cast<size_t>(k)];
+        if (n.kind == Kind::Element) flow.push_back({k, N + k});  // a lit element sends what it holds
+        if (n.parent >= 0) {
+            flow.push_back({n.parent, k});  // push down
+            if (n.kind != Kind::Sink) flow.push_back({N + k, N + n.parent});  // pull up
+        }
+    }
+    for (const Link& l : m_links) flow.push_back({N + l.s, l.r});
+    std::vector<char> src2(2 * static_cast<size_t>(N), 0);
+    for (int k = 0; k < N; ++k) src2[static_cast<size_t>(k)] = sources[static_cast<size_t>(k)];
+    const std::vector<char> reached2 = reachable_directed(2 * N, flow, src2);
+    m_reached.assign(static_cast<size_t>(N), 0);
+    for (int k = 0; k < N; ++k) m_reached[static_cast<size_t>(k)] = reached2[static_cast<size_t>(k)];
+    // Patches none of whose leaves is reached.
+    std::vector<char> lit_patch(m_scene.patches.size(), 0);
+    for (int leaf : m_leaves)
+        if (m_reached[static_cast<size_t>(leaf)]) lit_patch[static_cast<size_t>(m_nodes[static_cast<size_t>(leaf)].patch)] = 1;
+    m_left_out = 0;
+    for (char c : lit_patch) m_left_out += c ? 0 : 1;
+    m_links.erase(std::remove_if(m_links.begin(), m_links.end(),
+                                 [&](const Link& l) { return !reached2[static_cast<size_t>(N + l.s)]; }),
+                  m_links.end());
+}
+
+// G(x): pull the leaf radiosities x up (means and exitance tables), gather
+// along the links, push irradiance down to the leaves. With `correct`, a
+// closed leaf adds its row-sum deficit times its ancestors' mean arrival.
+void HierarchicalSolver::apply_G(const Eigen::VectorXd& x, Eigen::VectorXd& out, bool correct) {
     const size_t N = m_nodes.size();
-    Bn.assign(N, 0.0);
-    Hn.assign(N, 0.0);
-    std::vector<double> Hw(N, 0.0);  // sum of w * B_sender (row-sum correction)
-    // Pull: children have larger numbers than their parent.
-    for (size_t k = N; k-- > 0;) {
-        const Node& n = m_nodes[k];
-        if (n.sink()) continue;
-        if (n.child < 0) {
-            Bn[k] = x(m_leaf_index[k]);
-        } else {
-            const size_t a = static_cast<size_t>(n.child);
-            Bn[k] = (m_nodes[a].length * Bn[a] + m_nodes[a + 1].length * Bn[a + 1]) / n.length;
+    std::vector<double> leaf(static_cast<size_t>(m_element_leaves));
+    for (size_t i = 0; i < leaf.size(); ++i) leaf[i] = x(static_cast<Eigen::Index>(i));
+    pull_tables(leaf, m_Bn, m_I);
+    m_Hn.assign(N, 0.0);
+    m_J.assign(static_cast<size_t>(m_tables_count) * K, 0.0);
+    // Gather, in parallel over receivers.
+    const long R = static_cast<long>(m_receivers.size());
+#pragma omp parallel for num_threads(m_threads) schedule(dynamic, 256)
+    for (long q = 0; q < R; ++q) {
+        const int r = m_receivers[static_cast<size_t>(q)];
+        const Node& nr = m_nodes[static_cast<size_t>(r)];
+        double h = 0;
+        double* J = nr.cluster() ? &m_J[static_cast<size_t>(nr.table) * K] : nullptr;
+        for (int32_t k = m_link_start[static_cast<size_t>(q)]; k < m_link_start[static_cast<size_t>(q) + 1]; ++k) {
+            const Link& l = m_links[static_cast<size_t>(k)];
+            const Node& ns = m_nodes[static_cast<size_t>(l.s)];
+            const double v = ns.cluster() ? interpolate(&m_I[static_cast<size_t>(ns.table) * K], l.sbin)
+                                          : m_Bn[static_cast<size_t>(l.s)];
+            const double c = l.coef * v;
+            if (J) {
+                J[l.rbin.k] += (1 - l.rbin.t) * c;
+                J[l.rbin.next()] += l.rbin.t * c;
+            } else {
+                h += c;
+            }
         }
+        if (!J) m_Hn[static_cast<size_t>(r)] = h;
     }
-    // Gather.
-    for (const Link& l : m_links) {
-        Hn[static_cast<size_t>(l.r)] += l.F * Bn[static_cast<size_t>(l.s)];
-        Hw[static_cast<size_t>(l.r)] += l.w * Bn[static_cast<size_t>(l.s)];
-    }
-    // Push. A closed patch's leaf adds its row-sum deficit times the
-    // w-weighted mean radiosity of its ancestors' senders.
+    // Push: tables down the clusters, then onto sides, then down elements.
+    m_Ha.assign(N, 0.0);  // what arrived at ancestors (row-sum correction)
     for (size_t k = 0; k < N; ++k) {
-        if (m_nodes[k].parent < 0) continue;
-        const size_t q = static_cast<size_t>(m_nodes[k].parent);
-        const int i = m_leaf_index[k];
-        double correction = 0;
-        if (i >= 0) {
-            const size_t ii = static_cast<size_t>(i);
-            if (m_anc_w[ii] > 0)
-                correction = m_deficit[ii] * Hw[q] / m_anc_w[ii];
-            else if (m_anc_F[ii] > 0)
-                correction = m_deficit[ii] * Hn[q] / m_anc_F[ii];
+        const Node& n = m_nodes[k];
+        if (n.parent < 0) continue;
+        const Node& p = m_nodes[static_cast<size_t>(n.parent)];
+        if (n.cluster()) {
+            if (n.table >= 0 && p.table >= 0) {
+                double* dst = &m_J[static_cast<size_t>(n.table) * K];
+                const double* src = &m_J[static_cast<size_t>(p.table) * K];
+                for (int b = 0; b < K; ++b) dst[b] += src[b];
+            }
+            continue;
         }
-        Hn[k] += Hn[q] + correction;
-        Hw[k] += Hw[q];
+        double from_above = 0;
+        if (p.cluster()) {
+            // p is a leaf cluster: its table is its parent's (no links end there).
+            const Node& pp = m_nodes[static_cast<size_t>(p.parent >= 0 ? p.parent : n.parent)];
+            if (p.parent >= 0 && pp.table >= 0) from_above = read_cosine_lobe(&m_J[static_cast<size_t>(pp.table) * K], n.normal);
+        } else {
+            from_above = m_Hn[static_cast<size_t>(n.parent)] + m_Ha[static_cast<size_t>(n.parent)];
+        }
+        m_Ha[k] = from_above;
     }
-    Eigen::VectorXd g(static_cast<Eigen::Index>(m_leaves.size()));
-    for (size_t i = 0; i < m_leaves.size(); ++i) g(static_cast<Eigen::Index>(i)) = Hn[static_cast<size_t>(m_leaves[i])];
-    return g;
+    out.resize(static_cast<Eigen::Index>(m_element_leaves));
+    for (size_t i = 0; i < static_cast<size_t>(m_element_leaves); ++i) {
+        const size_t k = static_cast<size_t>(m_leaves[i]);
+        double h = m_Hn[k] + m_Ha[k];
+        if (correct && !m_deficit.empty() && m_deficit[i] != 0 && m_anc_sum[i] > 0)
+            h += m_deficit[i] * m_Ha[k] / m_anc_sum[i];
+        out(static_cast<Eigen::Index>(i)) = h;
+    }
 }
 
 void HierarchicalSolver::solve() {
     const auto t0 = Clock::now();
     collect_leaves();
-    const Eigen::Index n = static_cast<Eigen::Index>(m_leaves.size());
-    std::vector<double> Bn, Hn;
+    reach();
+    sort_links();
+    const Eigen::Index n = static_cast<Eigen::Index>(m_element_leaves);
+    // Row sums: a leaf of a patch whose light cannot leave the scene and
+    // that sees no sink must gather exactly 1 for B = 1 everywhere.
+    m_deficit.assign(static_cast<size_t>(n), 0.0);
+    m_anc_sum.assign(static_cast<size_t>(n), 0.0);
+    if (!m_closed_patch.empty()) {
+        Eigen::VectorXd ones = Eigen::VectorXd::Ones(n), g;
+        apply_G(ones, g, false);
+        for (Eigen::Index i = 0; i < n; ++i) {
+            const int node = m_leaves[static_cast<size_t>(i)];
+            if (!m_closed_patch[static_cast<size_t>(m_nodes[static_cast<size_t>(node)].patch)]) continue;
+            m_deficit[static_cast<size_t>(i)] = 1 - g(i);
+            m_anc_sum[static_cast<size_t>(i)] = m_Ha[static_cast<size_t>(node)];
+        }
+    }
+    m_B.assign(static_cast<size_t>(m_C), std::vector<double>(m_nodes.size(), 0.0));
+    m_H = m_B;
+    GmresOptions go;
+    go.tolerance = gmres_tolerance;
+    go.restart = n > 200000 ? 20 : 60;  // the Krylov basis is n x restart doubles
     for (int c = 0; c < m_C; ++c) {
-        Eigen::VectorXd E(n), rho_l(n), x(n);
+        Eigen::VectorXd E(n), rho_l(n), x(n), g;
         for (Eigen::Index i = 0; i < n; ++i) {
             const int node = m_leaves[static_cast<size_t>(i)];
             E(i) = emission(node, c);
             rho_l(i) = rho(node, c);
-            x(i) = m_B[static_cast<size_t>(c)][static_cast<size_t>(node)];  // warm start
+            x(i) = E(i);
         }
         auto apply = [&](const Eigen::VectorXd& v) -> Eigen::VectorXd {
-            return v - rho_l.cwiseProduct(apply_G(v, Bn, Hn));
+            apply_G(v, g, true);
+            return v - rho_l.cwiseProduct(g);
         };
         double rel = 0;
-        m_iterations += gmres(apply, E, x, rel);
-        // Final per-node values and the residual (inf-norm, as solve_exact).
+        m_iterations += gmres(apply, E, x, rel, go);
         const Eigen::VectorXd r = E - apply(x);
         const double scale = std::max(E.cwiseAbs().maxCoeff(), x.cwiseAbs().maxCoeff());
         if (scale > 0) m_residual = std::max(m_residual, r.cwiseAbs().maxCoeff() / scale);
-        m_B[static_cast<size_t>(c)] = Bn;
-        m_H[static_cast<size_t>(c)] = Hn;
-    }
-    for (size_t k = 0; k < m_nodes.size(); ++k) {
-        double b = 0;
-        for (int c = 0; c < m_C; ++c) b = std::max(b, m_B[static_cast<size_t>(c)][k]);
-        m_Bmax[k] = b;
+        // Per-node values of the final x (apply left m_Bn, m_Hn, m_Ha for it).
+        auto& B = m_B[static_cast<size_t>(c)];
+        auto& H = m_H[static_cast<size_t>(c)];
+        for (size_t k = 0; k < m_nodes.size(); ++k) {
+            B[k] = m_Bn[k];
+            H[k] = m_Hn[k] + m_Ha[k];
+        }
+        for (Eigen::Index i = 0; i < n; ++i) H[static_cast<size_t>(m_leaves[static_cast<size_t>(i)])] = g(i);
+        progress(fmt::format("solved channel {} of {}", c + 1, m_C), -1);
     }
     m_solve_time += seconds_since(t0);
 }
@@ -585,24 +963,34 @@ void HierarchicalSolver::solve() {
 Solution HierarchicalSolver::run() {
     const auto t_start = Clock::now();
     refuse_closed_white();
-    build_roots();
+    build_tree();
+    collect_leaves();
+    bool lit = false;
+    for (int leaf : m_leaves)
+        for (int c = 0; c < m_C; ++c) lit = lit || emission(leaf, c) > 0;
     m_B.assign(static_cast<size_t>(m_C), std::vector<double>(m_nodes.size(), 0.0));
     m_H = m_B;
-    m_Bmax.assign(m_nodes.size(), 0.0);
-    bool lit = false;
-    for (int p = 0; p < m_patch_roots; ++p)
-        for (int c = 0; c < m_C; ++c) lit = lit || emission(p, c) > 0;
-
-    if (lit) {
-        // Refine, solve, refine again until no link splits.
-        initial_links();
+    if (lit && m_root >= 0) {
+        // Refine against a guess, solve, refine against the solution, ...
+        m_links.push_back(link_between(m_root, m_root));
+        progress("refining", -1);
+        refine(leaf_guess());
         solve();
-        for (int pass = 0; pass < m_opt.max_passes; ++pass) {
-            if (!refine()) break;
+        for (int pass = 1; pass < m_opt.max_passes; ++pass) {
+            collect_leaves();
+            std::vector<double> bmax(static_cast<size_t>(m_element_leaves), 0.0);
+            for (size_t i = 0; i < bmax.size(); ++i)
+                for (int c = 0; c < m_C; ++c)
+                    bmax[i] = std::max(bmax[i], m_B[static_cast<size_t>(c)][static_cast<size_t>(m_leaves[i])]);
+            progress(fmt::format("refining (pass {})", pass + 1), -1);
+            if (!refine(bmax)) break;
             solve();
         }
     } else {
         collect_leaves();  // nothing emits: B = 0 everywhere, no link needed
+        m_left_out = static_cast<long>(m_scene.patches.size());
+        m_B.assign(static_cast<size_t>(m_C), std::vector<double>(m_nodes.size(), 0.0));
+        m_H = m_B;
     }
 
     Solution sol;
@@ -612,6 +1000,9 @@ Solution HierarchicalSolver::run() {
     sol.vis_eps = m_vis_eps;
     sol.channels = m_C;
     sol.patches.resize(m_scene.patches.size());
+    std::vector<int> patch_root(m_scene.patches.size(), -1);
+    for (size_t k = 0; k < m_nodes.size(); ++k)
+        if (m_nodes[k].kind == Kind::Element && m_nodes[k].depth == 0) patch_root[static_cast<size_t>(m_nodes[k].patch)] = static_cast<int>(k);
     for (int leaf : m_leaves) {
         const Node& nd = m_nodes[static_cast<size_t>(leaf)];
         const Patch& patch = m_scene.patches[static_cast<size_t>(nd.patch)];
@@ -626,7 +1017,8 @@ Solution HierarchicalSolver::run() {
         PatchResult& pr = sol.patches[p];
         std::sort(pr.elements.begin(), pr.elements.end(),
                   [](const ElementValue& x, const ElementValue& y) { return x.t0 < y.t0; });
-        for (int c = 0; c < m_C; ++c) pr.radiosity.push_back(m_B[static_cast<size_t>(c)][p]);  // root = pulled mean
+        for (int c = 0; c < m_C; ++c)
+            pr.radiosity.push_back(m_B[static_cast<size_t>(c)][static_cast<size_t>(patch_root[p])]);  // pulled mean
     }
 
     // Totals: absorbed by patches ((1 - rho) H) and sinks; escaped = sent - landed.
@@ -634,18 +1026,18 @@ Solution HierarchicalSolver::run() {
         const auto& B = m_B[static_cast<size_t>(c)];
         const auto& H = m_H[static_cast<size_t>(c)];
         CompensatedSum emitted, absorbed, sent, landed;
-        for (int leaf : m_leaves) {
-            const double L = m_nodes[static_cast<size_t>(leaf)].length;
-            emitted.add(L * emission(leaf, c));
-            absorbed.add(L * (1 - rho(leaf, c)) * H[static_cast<size_t>(leaf)]);
-            sent.add(L * B[static_cast<size_t>(leaf)]);
-            landed.add(L * H[static_cast<size_t>(leaf)]);
-        }
-        for (const Link& l : m_links) {
-            if (!m_nodes[static_cast<size_t>(l.r)].sink()) continue;
-            const double P = m_nodes[static_cast<size_t>(l.r)].length * l.F * B[static_cast<size_t>(l.s)];
-            landed.add(P);
-            absorbed.add(P);
+        for (size_t k = 0; k < m_nodes.size(); ++k) {
+            const Node& n = m_nodes[k];
+            if (n.child >= 0 || n.cluster()) continue;
+            const double L = n.length;
+            if (n.kind == Kind::Element) {
+                emitted.add(L * emission(static_cast<int>(k), c));
+                absorbed.add(L * (1 - rho(static_cast<int>(k), c)) * H[k]);
+                sent.add(L * B[k]);
+            } else {
+                absorbed.add(L * H[k]);
+            }
+            landed.add(L * H[k]);
         }
         const double em = emitted.value(), ab = absorbed.value();
         double es = sent.value() - landed.value();
@@ -658,7 +1050,7 @@ Solution HierarchicalSolver::run() {
 
     sol.stats.form_factor_time_s = m_ff_time;
     sol.stats.linear_solve_time_s = m_solve_time;
-    sol.stats.elements = static_cast<long>(m_leaves.size());
+    sol.stats.elements = m_element_leaves;
     sol.stats.links = static_cast<long>(m_links.size());
     sol.stats.patches_left_out = m_left_out;
     sol.stats.iterations = m_iterations;

@@ -1,23 +1,26 @@
 #include "solver/reachability.h"
 
-#include <boost/graph/adjacency_list.hpp>
-#include <boost/graph/connected_components.hpp>
+#include <boost/graph/breadth_first_search.hpp>
+#include <boost/graph/compressed_sparse_row_graph.hpp>
 
 namespace flatrad {
 
-std::vector<char> reachable_patches(int patches, const std::vector<std::pair<int, int>>& facing,
-                                    const std::vector<char>& emits) {
-    using Graph = boost::adjacency_list<boost::vecS, boost::vecS, boost::undirectedS>;
-    Graph graph(static_cast<size_t>(patches));
-    for (const auto& [a, b] : facing) boost::add_edge(static_cast<size_t>(a), static_cast<size_t>(b), graph);
-    std::vector<int> component(static_cast<size_t>(patches));
-    const int count = boost::connected_components(graph, component.data());
-    std::vector<char> lit_component(static_cast<size_t>(count), 0);
-    for (int p = 0; p < patches; ++p)
-        if (emits[static_cast<size_t>(p)]) lit_component[static_cast<size_t>(component[static_cast<size_t>(p)])] = 1;
-    std::vector<char> reached(static_cast<size_t>(patches));
-    for (int p = 0; p < patches; ++p)
-        reached[static_cast<size_t>(p)] = lit_component[static_cast<size_t>(component[static_cast<size_t>(p)])];
+std::vector<char> reachable_directed(int vertices, const std::vector<std::pair<int, int>>& edges,
+                                     const std::vector<char>& sources) {
+    using Graph = boost::compressed_sparse_row_graph<boost::directedS, boost::no_property, boost::no_property,
+                                                     boost::no_property, uint32_t, uint32_t>;
+    std::vector<std::pair<uint32_t, uint32_t>> e;
+    e.reserve(edges.size());
+    for (const auto& [a, b] : edges) e.push_back({static_cast<uint32_t>(a), static_cast<uint32_t>(b)});
+    const Graph graph(boost::edges_are_unsorted_multi_pass, e.begin(), e.end(), static_cast<uint32_t>(vertices));
+    std::vector<boost::default_color_type> color(static_cast<size_t>(vertices), boost::white_color);
+    auto color_map = boost::make_iterator_property_map(color.begin(), boost::get(boost::vertex_index, graph));
+    boost::queue<uint32_t> queue;
+    for (int v = 0; v < vertices; ++v)
+        if (sources[static_cast<size_t>(v)] && color[static_cast<size_t>(v)] == boost::white_color)
+            boost::breadth_first_visit(graph, static_cast<uint32_t>(v), queue, boost::default_bfs_visitor(), color_map);
+    std::vector<char> reached(static_cast<size_t>(vertices));
+    for (int v = 0; v < vertices; ++v) reached[static_cast<size_t>(v)] = color[static_cast<size_t>(v)] != boost::white_color;
     return reached;
 }
 

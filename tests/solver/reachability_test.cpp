@@ -12,13 +12,13 @@
 
 using namespace flatrad;
 
-TEST_CASE("reachability: components with an emitter are reached, others not") {
-    // 0-1 face each other, 2-3-4 form a chain, 5 alone; 1 and 5 emit.
-    const std::vector<std::pair<int, int>> facing{{0, 1}, {2, 3}, {3, 4}};
-    const std::vector<char> emits{0, 1, 0, 0, 0, 1};
-    const std::vector<char> r = reachable_patches(6, facing, emits);
-    CHECK(r == std::vector<char>{1, 1, 0, 0, 0, 1});
-    CHECK(reachable_patches(3, {}, {0, 0, 0}) == std::vector<char>{0, 0, 0});
+TEST_CASE("reachability: what a breadth-first search from the sources reaches, along edge directions") {
+    // 0 -> 1 -> 2, 3 -> 0 (3 not reached from 0), 4 alone, 5 -> 6; sources 0 and 5.
+    const std::vector<std::pair<int, int>> edges{{0, 1}, {1, 2}, {3, 0}, {5, 6}};
+    const std::vector<char> r = reachable_directed(7, edges, {1, 0, 0, 0, 0, 1, 0});
+    CHECK(r == std::vector<char>{1, 1, 1, 0, 0, 1, 1});
+    CHECK(reachable_directed(3, {}, {0, 0, 0}) == std::vector<char>{0, 0, 0});
+    CHECK(reachable_directed(3, {{0, 1}, {1, 2}, {2, 0}}, {0, 0, 1}) == std::vector<char>{1, 1, 1});
 }
 
 TEST_CASE("hierarchical: a dark closed box beside a lit one is left out, the lit one unchanged") {

@@ -1,0 +1,105 @@
+#pragma once
+/// The directional model of a cluster (DESIGN.md §3: "cluster senders and
+/// receivers need a directional model ... a table per cluster is cheap"):
+/// functions of one angle on a table of `directional_bins` equally spaced
+/// directions phi_k = k 2 pi / K, read by linear interpolation (periodic).
+///
+/// A surface element e (length L_e, radiosity B_e, lit normal n_e) sends
+/// into direction u(phi) the power per radian (B_e L_e / 2) cos+(n_e . u)
+/// (radiance B / 2 in flatland: the cosine integrates to 2 over the half
+/// circle), cos+ = max(0, cos). A cluster's exitance table is the sum over
+/// its elements: I(phi_k). Light arriving at a cluster from direction psi
+/// (the direction towards the sender) with density a (power per unit length
+/// across the beam) gives each element e irradiance a cos+(n_e . u(psi));
+/// the cluster's irradiance table J(psi_k) holds the arrivals spread onto
+/// the two nearest directions with the interpolation weights, and an
+/// element reads sum_k J_k cos+(n_e . u(psi_k)), i.e. its cosine
+/// interpolated at psi.
+///
+/// Error: linear interpolation of a function f between samples h apart is
+/// off by at most h^2/8 max|f''| where f is smooth; at the kink of cos+ (a
+/// grazing element) by up to h/4 of its weight. Both show in the table's
+/// second differences, which interpolation_error() returns as the estimate
+/// used by the refinement oracle: |f_{k-1} - 2 f_k + f_{k+1}| / 4 at the two
+/// samples around phi (twice the smooth-case h^2 f''/8, for the kink).
+#include <array>
+#include <cmath>
+#include <numbers>
+
+#include "engine/geometry.h"
+
+namespace flatrad {
+
+/// 32 directions: 0.196 rad apart; the smooth-case interpolation error of a
+/// cosine lobe is h^2/8 = 0.5%, and every link with more error than its
+/// share gets refined below the clusters anyway.
+inline constexpr int directional_bins = 32;
+
+/// Where an angle falls in the table: samples k and (k + 1) mod K, weight t
+/// of the second.
+struct BinWeight {
+    int k = 0;
+    double t = 0;
+    int next() const { return k + 1 == directional_bins ? 0 : k + 1; }
+};
+
+inline BinWeight bin_of(Vec2 u) {
+    constexpr double step = 2 * std::numbers::pi / directional_bins;
+    double phi = std::atan2(u.y, u.x);
+    if (phi < 0) phi += 2 * std::numbers::pi;
+    double x = phi / step;
+    int k = static_cast<int>(std::floor(x));
+    double t = x - k;
+    if (k >= directional_bins) k -= directional_bins;  // phi rounded up to 2 pi
+    if (k < 0) k = 0;
+    return {k, t};
+}
+
+/// Unit directions of the samples.
+inline const std::array<Vec2, directional_bins>& bin_directions() {
+    static const std::array<Vec2, directional_bins> dirs = [] {
+        std::array<Vec2, directional_bins> d{};
+        for (int k = 0; k < directional_bins; ++k) {
+            const double phi = 2 * std::numbers::pi * k / directional_bins;
+            d[static_cast<size_t>(k)] = {std::cos(phi), std::sin(phi)};
+        }
+        return d;
+    }();
+    return dirs;
+}
+
+/// Adds w cos+(n . u(phi_k)) to table[0..K).
+inline void add_cosine_lobe(double* table, Vec2 n, double w) {
+    const auto& d = bin_directions();
+    for (int k = 0; k < directional_bins; ++k) {
+        const double c = n.x * d[static_cast<size_t>(k)].x + n.y * d[static_cast<size_t>(k)].y;
+        if (c > 0) table[k] += w * c;
+    }
+}
+
+/// sum_k J_k cos+(n . u(psi_k)): what an element of normal n receives.
+inline double read_cosine_lobe(const double* table, Vec2 n) {
+    const auto& d = bin_directions();
+    double s = 0;
+    for (int k = 0; k < directional_bins; ++k) {
+        const double c = n.x * d[static_cast<size_t>(k)].x + n.y * d[static_cast<size_t>(k)].y;
+        if (c > 0) s += table[k] * c;
+    }
+    return s;
+}
+
+inline double interpolate(const double* table, BinWeight b) {
+    return (1 - b.t) * table[b.k] + b.t * table[b.next()];
+}
+
+/// Estimated interpolation error of `table` at b (see the header).
+inline double interpolation_error(const double* table, BinWeight b) {
+    auto second = [&](int k) {
+        const int km = k == 0 ? directional_bins - 1 : k - 1;
+        const int kp = k + 1 == directional_bins ? 0 : k + 1;
+        return std::abs(table[km] - 2 * table[k] + table[kp]);
+    };
+    return 0.25 * std::max(second(b.k), second(b.next()));
+}
+
+}  // namespace flatrad
