@@ -79,7 +79,7 @@ CLI::App* add_compare_command(CLI::App& app, CompareArgs& a) {
         ->type_name("N")
         ->capture_default_str();
     cmd->add_option("--threads", a.threads, "Threads; 0: all cores.")->type_name("N")->capture_default_str();
-    cmd->add_flag("-q,--quiet", a.quiet, "No table on stderr.");
+    cmd->add_flag("-q,--quiet", a.quiet, "No table on stderr (and no progress line).");
     return cmd;
 }
 
