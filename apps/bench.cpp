@@ -5,14 +5,21 @@
 //   flatrad_bench rooms  [--repeat R] [--sizes E,...] [--blockers M,...]
 //   flatrad_bench ffcost [--repeat R] [--counts M,...]
 //   flatrad_bench matrix [--repeat R] [--plate-length L] [--seed S] [--sweep-lengths]
+//   flatrad_bench scale  [--sizes N,...] [--eps E] [--repeat R] [--density D] ... [--timeout SEC]
+//   flatrad_bench versus [--elements M] [--eps-list E,...] ... [--reference-check]
 //   flatrad_bench all
 //
-// `rooms` runs the real CLI (`flatrad solve`, found beside this program) as a
-// child process, for wall time and peak memory; `ffcost` and `matrix` call
-// the library in-process. Scenes are generated here with fixed seeds, so
-// every run measures the same geometry.
+// `rooms` and `scale` run the real CLI (`flatrad solve`, found beside this
+// program) as a child process, for wall time and peak memory; `ffcost`,
+// `matrix` and `versus` call the library in-process. Scenes are generated
+// with fixed seeds, so every run measures the same geometry: here, or (scale,
+// versus) by scripts/make-scene, cached under <build>/bench-scenes.
+#include <fcntl.h>
+#include <poll.h>
+#include <signal.h>
 #include <spawn.h>
 #include <sys/resource.h>
+#include <sys/syscall.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -35,15 +42,18 @@
 #include <set>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "cli/compare_command.h"
 #include "engine/formfactor.h"
 #include "engine/geometry.h"
 #include "engine/scene.h"
 #include "solver/exact_solver.h"
+#include "solver/hierarchical_solver.h"
 #include "visibility/exact_visibility.h"
 
 extern char** environ;
@@ -77,6 +87,23 @@ constexpr const char* usage_text =
     "         the exact form-factor matrix of a room of 160 wall segments and 840\n"
     "         two-sided plates (1840 patches). Defaults: R 3, L 0.025, S 1;\n"
     "         --sweep-lengths adds plate lengths 0.01 and 0.05.\n"
+    "  scale  [--sizes N,...] [--eps E] [--vis-eps V] [--repeat R] [--density D] [--lamps L]\n"
+    "         [--seed S] [--timeout SEC] [--max-memory MIB] [--threads T] [--keep-going]\n"
+    "         `flatrad solve --method hierarchical` (child process) on forests of N segments made by\n"
+    "         `scripts/make-scene N --seed S --density D --lamps L` (cached in <build>/bench-scenes):\n"
+    "         load, solve and wall time, elements, links, iterations, peak RSS, time / (N log2 N)\n"
+    "         and the empirical exponent. A run is killed after SEC seconds (reported as timed out;\n"
+    "         larger sizes are then skipped unless --keep-going); memory limited to MIB (RLIMIT_DATA,\n"
+    "         0: none). Defaults: sizes 1000,10000,100000,1000000, E 0.01, R 3, D 30, L 1, S 1,\n"
+    "         SEC 600, MIB 8192, T 0 (all cores).\n"
+    "  versus [--elements M] [--eps-list E,...] [--segments N] [--density D] [--lamps L] [--seed S]\n"
+    "         [--repeat R] [--threads T] [--reference-check] [--all-eps]\n"
+    "         solve_hierarchical at each eps against solve_exact at K = round(M / patches) elements\n"
+    "         per patch (in-process) on `scripts/make-scene N --seed S --density D --lamps L`: time,\n"
+    "         relative L2 error (as `flatrad compare`), speed-up; the largest eps with error <= 1%.\n"
+    "         --reference-check also solves exactly at 2K to estimate the reference's own error.\n"
+    "         Eps run largest first; smaller ones stop once one is slower than exact (--all-eps: not).\n"
+    "         Defaults: M 4000, eps 2,1,0.5,0.2,0.1,0.05,0.02,0.01, N 1000, D 30, L 1, S 1, R 3, T 0.\n"
     "  all    ffcost, matrix and rooms with their defaults (rooms: E >= 4000 run once).\n";
 
 // ---------------------------------------------------------------------------
@@ -176,6 +203,17 @@ std::vector<long> parse_list(const std::string& text, const std::string& flag, l
     while (start <= text.size()) {
         const size_t comma = std::min(text.find(',', start), text.size());
         out.push_back(parse_long(text.substr(start, comma - start), flag, min_value));
+        start = comma + 1;
+    }
+    return out;
+}
+
+std::vector<double> parse_positive_list(const std::string& text, const std::string& flag) {
+    std::vector<double> out;
+    size_t start = 0;
+    while (start <= text.size()) {
+        const size_t comma = std::min(text.find(',', start), text.size());
+        out.push_back(parse_positive(text.substr(start, comma - start), flag));
         start = comma + 1;
     }
     return out;
@@ -300,31 +338,103 @@ Json room_scene(long E, long M, int W) {
                 {"surfaces", std::move(surfaces)}};
 }
 
+// A child process run to its end (or killed at its time limit).
 struct ChildRun {
     int status = -1;  // exit status, or 128 + signal
     double wall_s = 0;
     long max_rss_kib = 0;
+    bool timed_out = false;  // killed (SIGKILL) at ChildOptions::timeout_s
+};
+
+struct ChildOptions {
+    std::filesystem::path stdout_path;  // non-empty: the child's stdout goes to this file (truncated)
+    std::filesystem::path stderr_path;  // non-empty: the child's stderr goes to this file (truncated)
+    double timeout_s = 0;               // > 0: killed with SIGKILL after this long
+    long max_memory_mib = 0;            // > 0: the child's RLIMIT_DATA (private writable memory)
 };
 
 // posix_spawn + wait4: wall time around the child's whole life and its peak
-// resident set (ru_maxrss, KiB on Linux).
-ChildRun run_child(const std::vector<std::string>& args) {
+// resident set (ru_maxrss, KiB on Linux). With a timeout, the parent waits
+// on a pidfd (poll) for at most that long, then kills the child; without
+// pidfd_open (Linux < 5.3) it looks every 10 ms instead.
+ChildRun run_child(const std::vector<std::string>& args, const ChildOptions& o = {}) {
     std::vector<char*> argv;
     for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
     argv.push_back(nullptr);
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    struct ActionsGuard {
+        posix_spawn_file_actions_t* a;
+        ~ActionsGuard() { posix_spawn_file_actions_destroy(a); }
+    } guard{&actions};
+    if (!o.stdout_path.empty())
+        posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, o.stdout_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
+                                         0644);
+    if (!o.stderr_path.empty())
+        posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, o.stderr_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
+                                         0644);
     ChildRun r;
     pid_t pid = 0;
     const auto t0 = Clock::now();
-    if (const int rc = posix_spawn(&pid, argv[0], nullptr, nullptr, argv.data(), environ); rc != 0)
+    if (const int rc = posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ); rc != 0)
         throw std::runtime_error(fmt::format("cannot start {}: {}", args[0], std::strerror(rc)));
+    // glibc's posix_spawn returns once the child has called exec, so the
+    // limit is in place before the program does any real work.
+    if (o.max_memory_mib > 0) {
+        const rlim_t bytes = static_cast<rlim_t>(o.max_memory_mib) * 1024 * 1024;
+        const struct rlimit limit {bytes, bytes};
+        if (prlimit(pid, RLIMIT_DATA, &limit, nullptr) != 0)
+            fmt::print(stderr, "warning: cannot limit the memory of {}: {}\n", args[0], std::strerror(errno));
+    }
     int status = 0;
     struct rusage usage {};
-    while (wait4(pid, &status, 0, &usage) < 0)
-        if (errno != EINTR) throw std::runtime_error(fmt::format("wait4: {}", std::strerror(errno)));
+    bool reaped = false;
+    if (o.timeout_s > 0) {
+#ifdef SYS_pidfd_open
+        const int pidfd = static_cast<int>(syscall(SYS_pidfd_open, pid, 0));
+#else
+        const int pidfd = -1;
+#endif
+        for (;;) {
+            const double left = o.timeout_s - seconds_since(t0);
+            if (left <= 0) {
+                kill(pid, SIGKILL);
+                r.timed_out = true;
+                break;
+            }
+            if (pidfd >= 0) {
+                struct pollfd p {pidfd, POLLIN, 0};
+                const int rc = poll(&p, 1, static_cast<int>(std::min(left * 1000 + 1, 3.6e6)));
+                if (rc > 0) break;  // exited: reaped below
+                if (rc < 0 && errno != EINTR) throw std::runtime_error(fmt::format("poll: {}", std::strerror(errno)));
+            } else {
+                const pid_t w = wait4(pid, &status, WNOHANG, &usage);
+                if (w == pid) {
+                    reaped = true;
+                    break;
+                }
+                if (w < 0 && errno != EINTR) throw std::runtime_error(fmt::format("wait4: {}", std::strerror(errno)));
+                std::this_thread::sleep_for(std::chrono::milliseconds(10));
+            }
+        }
+        if (pidfd >= 0) close(pidfd);
+    }
+    if (!reaped)
+        while (wait4(pid, &status, 0, &usage) < 0)
+            if (errno != EINTR) throw std::runtime_error(fmt::format("wait4: {}", std::strerror(errno)));
     r.wall_s = seconds_since(t0);
     r.status = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
     r.max_rss_kib = usage.ru_maxrss;
     return r;
+}
+
+// The last non-empty line of a text file ("" when none), for a child's error.
+std::string last_line(const std::filesystem::path& path) {
+    std::ifstream in(path);
+    std::string line, last;
+    while (std::getline(in, line))
+        if (line.find_first_not_of(" \t\r") != std::string::npos) last = line;
+    return last;
 }
 
 std::filesystem::path program_dir() {
@@ -354,6 +464,18 @@ private:
     std::filesystem::path m_path;
 };
 
+// A copy of the `flatrad` beside this program, in `tmp`: a rebuild of the
+// build tree during a long run would otherwise change the program between
+// rows.
+std::filesystem::path private_copy_of_flatrad(const TempDir& tmp) {
+    const std::filesystem::path source = program_dir() / "flatrad";
+    if (!std::filesystem::exists(source))
+        throw std::runtime_error(fmt::format("{} not found (build the flatrad target)", source.string()));
+    const std::filesystem::path copy = tmp.path() / "flatrad";
+    std::filesystem::copy_file(source, copy);
+    return copy;
+}
+
 struct RoomsOptions {
     int repeat = 3;
     std::vector<long> sizes{500, 1000, 2000, 4000};
@@ -371,14 +493,9 @@ struct RoomRow {
 };
 
 void run_rooms(const RoomsOptions& o, const std::string& cmd) {
-    const std::filesystem::path source = program_dir() / "flatrad";
-    if (!std::filesystem::exists(source))
-        throw std::runtime_error(fmt::format("{} not found (build the flatrad target)", source.string()));
     TempDir tmp;
-    // Run a private copy: a rebuild of the build tree during a long run
-    // would otherwise change the program between rows.
-    const std::filesystem::path flatrad = tmp.path() / "flatrad";
-    std::filesystem::copy_file(source, flatrad);
+    const std::filesystem::path source = program_dir() / "flatrad";
+    const std::filesystem::path flatrad = private_copy_of_flatrad(tmp);
 
     fmt::print("## rooms: `flatrad solve SCENE --method exact -o OUT --quiet` as a child process\n");
     fmt::print("command: {}\n", cmd);
@@ -693,9 +810,456 @@ void run_matrix(const MatrixOptions& o, const std::string& cmd) {
 }
 
 // ---------------------------------------------------------------------------
+// Generated forests (scripts/make-scene), cached under the build directory.
+
+#ifndef FLATRAD_SOURCE_DIR
+#error "FLATRAD_SOURCE_DIR (the source tree, for scripts/make-scene) is defined in apps/CMakeLists.txt"
+#endif
+
+std::filesystem::path make_scene_script() {
+    return std::filesystem::path(FLATRAD_SOURCE_DIR) / "scripts" / "make-scene";
+}
+
+// <build>/bench-scenes: this program is <build>/apps/flatrad_bench.
+std::filesystem::path scene_cache_dir() { return program_dir().parent_path() / "bench-scenes"; }
+
+std::string read_text(const std::filesystem::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw std::runtime_error(fmt::format("cannot read {}", path.string()));
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+void write_text(const std::filesystem::path& path, const std::string& text) {
+    std::ofstream f(path, std::ios::binary);
+    f << text;
+    if (!f) throw std::runtime_error(fmt::format("cannot write {}", path.string()));
+}
+
+uint64_t fnv1a_64(const std::string& text) {
+    uint64_t h = 14695981039346656037ull;
+    for (const char c : text) {
+        h ^= static_cast<unsigned char>(c);
+        h *= 1099511628211ull;
+    }
+    return h;
+}
+
+// `scripts/make-scene N --seed S --density D --lamps L`: a square room at D
+// blockers per unit area, K ceiling lamps, N segments in all.
+struct ForestSpec {
+    long segments = 0;
+    double density = 30;  // data/forest.json: 3000 blockers in 10 x 10
+    int lamps = 1;
+    long seed = 1;
+};
+
+struct CachedScene {
+    std::filesystem::path path;
+    double generate_s = -1;  // wall time of make-scene; < 0: taken from the cache
+};
+
+// The cache's name for it (scale and versus share a scene of the same arguments).
+std::string forest_stem(const ForestSpec& f) {
+    return fmt::format("forest-N{}-D{}-L{}-S{}", f.segments, f.density, f.lamps, f.seed);
+}
+
+// The scene as <build>/bench-scenes/<stem>.json. It is generated unless the
+// cache holds it with a key file (<stem>.json.key) naming the same command
+// line and the same make-scene (a hash of the script's text), so that an
+// edited generator or other arguments make a fresh scene.
+CachedScene forest_scene(const std::string& stem, const ForestSpec& f) {
+    const std::filesystem::path script = make_scene_script();
+    if (!std::filesystem::exists(script))
+        throw std::runtime_error(fmt::format("{} not found (the source tree this program was built from)",
+                                             script.string()));
+    const std::filesystem::path dir = scene_cache_dir();
+    std::filesystem::create_directories(dir);
+    const std::vector<std::string> args{script.string(), std::to_string(f.segments), "--seed", std::to_string(f.seed),
+                                        "--density",      fmt::format("{}", f.density), "--lamps",
+                                        std::to_string(f.lamps)};
+    std::string key;
+    for (const std::string& a : args) {
+        if (!key.empty()) key += ' ';
+        key += shell_quote(a);
+    }
+    key += fmt::format("\nmake-scene fnv1a-64 {:016x}\n", fnv1a_64(read_text(script)));
+
+    CachedScene c{dir / (stem + ".json")};
+    std::filesystem::path key_path = c.path;
+    key_path += ".key";
+    std::error_code ec;
+    if (std::filesystem::exists(c.path, ec) && std::filesystem::exists(key_path, ec) && read_text(key_path) == key)
+        return c;
+
+    const std::filesystem::path part = dir / fmt::format("{}.json.part{}", stem, getpid());
+    fmt::print(stderr, "generating {} ({} segments) ...\n", c.path.string(), f.segments);
+    ChildOptions co;
+    co.stdout_path = part;
+    const ChildRun g = run_child(args, co);
+    if (g.status != 0) {
+        std::filesystem::remove(part, ec);
+        throw std::runtime_error(fmt::format("scripts/make-scene {} failed (status {})", f.segments, g.status));
+    }
+    std::filesystem::remove(key_path, ec);
+    std::filesystem::rename(part, c.path);
+    write_text(key_path, key);
+    c.generate_s = g.wall_s;
+    fmt::print(stderr, "generated {} in {:.1f} s\n", c.path.string(), g.wall_s);
+    return c;
+}
+
+// Only `stats` of a result file: the patches (most of a large result) are
+// dropped while parsing.
+nlohmann::json result_stats(const std::filesystem::path& path) {
+    std::ifstream in(path);
+    if (!in) throw std::runtime_error(fmt::format("cannot read {}", path.string()));
+    const nlohmann::json result = nlohmann::json::parse(
+        in, [](int depth, nlohmann::json::parse_event_t event, nlohmann::json& parsed) {
+            return !(depth == 1 && event == nlohmann::json::parse_event_t::key && parsed == "patches");
+        });
+    return result.at("stats");
+}
+
+// Slope of log y against log x, least squares ("" with fewer than 2 points).
+std::optional<double> log_log_slope(const std::vector<double>& x, const std::vector<double>& y) {
+    if (x.size() < 2) return std::nullopt;
+    double mx = 0, my = 0;
+    for (size_t k = 0; k < x.size(); ++k) {
+        mx += std::log(x[k]);
+        my += std::log(y[k]);
+    }
+    mx /= static_cast<double>(x.size());
+    my /= static_cast<double>(x.size());
+    double sxy = 0, sxx = 0;
+    for (size_t k = 0; k < x.size(); ++k) {
+        sxy += (std::log(x[k]) - mx) * (std::log(y[k]) - my);
+        sxx += (std::log(x[k]) - mx) * (std::log(x[k]) - mx);
+    }
+    if (sxx == 0) return std::nullopt;
+    return sxy / sxx;
+}
+
+// ---------------------------------------------------------------------------
+// scale: the hierarchical solver on forests of growing size (child process).
+
+struct ScaleOptions {
+    std::vector<long> sizes{1000, 10000, 100000, 1000000};
+    double eps = 1e-2;
+    std::optional<double> vis_eps;
+    int repeat = 3;
+    double density = 30;
+    int lamps = 1;
+    long seed = 1;
+    double timeout_s = 600;
+    long max_memory_mib = 8192;
+    int threads = 0;
+    bool keep_going = false;
+};
+
+struct ScaleRow {
+    long N = 0;
+    size_t patches = 0;
+    double generate_s = -1;
+    int runs = 0, threads = 0;
+    double load_s = 0, solve_s = 0, wall_s = 0, rss_mib = 0;
+    long elements = 0, links = 0, iterations = 0;
+    std::string failure;  // why there is no (or only part of a) measurement
+    bool stop = false;    // timed out or failed: larger sizes are skipped (unless --keep-going)
+};
+
+void run_scale(ScaleOptions o, const std::string& cmd) {
+    std::sort(o.sizes.begin(), o.sizes.end());
+    o.sizes.erase(std::unique(o.sizes.begin(), o.sizes.end()), o.sizes.end());
+    TempDir tmp;
+    const std::filesystem::path flatrad = private_copy_of_flatrad(tmp);
+
+    fmt::print("## scale: `flatrad solve SCENE --method hierarchical --eps {}{} -o OUT --quiet` as a child process\n",
+               o.eps, o.vis_eps ? fmt::format(" --vis-eps {}", *o.vis_eps) : "");
+    fmt::print("command: {}\n", cmd);
+    fmt::print("program: {} (copied at start, so that a rebuild cannot change it mid-run)\n",
+               (program_dir() / "flatrad").string());
+    fmt::print("scene: `scripts/make-scene N --seed {} --density {} --lamps {}`: a square room (4 segments, lit in,\n"
+               "       reflectance 0.7) of side sqrt(B / {}), {} ceiling lamp(s) and B = N - {} two-sided blockers\n"
+               "       of length 0.05-0.15 (reflectance 0.3), so the density, not the room, stays the same;\n"
+               "       cached in {}.\n",
+               o.seed, o.density, o.lamps, o.density, o.lamps, 4 + o.lamps, scene_cache_dir().string());
+    fmt::print("times: medians over {} run(s) of each size; solve = the result's stats.time_s, wall = the child's\n"
+               "       whole life (start, reading, solving, writing the result), load = flatrad::load_scene of the\n"
+               "       file in this process (reading and checking the scene, as the CLI does first);\n"
+               "       gen = make-scene's wall time (cached: generated by an earlier run). RSS = max ru_maxrss.\n"
+               "       t/NlogN = (solve / (N log2 N)) over the first row's: flat for O(N log N) growth.\n"
+               "       exponent = log(solve / solve_prev) / log(N / N_prev) (1 = linear, 2 = quadratic).\n"
+               "limits: each run is killed after {} s{}; memory (RLIMIT_DATA) {}.\n",
+               o.repeat, o.timeout_s, o.keep_going ? "" : " (then larger sizes are skipped: --keep-going runs them)",
+               o.max_memory_mib > 0 ? fmt::format("{} MiB", o.max_memory_mib) : "not limited");
+    std::fflush(stdout);
+
+    std::vector<ScaleRow> rows;
+    std::optional<long> stopped_at;
+    const std::filesystem::path out_path = tmp.path() / "result.json";
+    const std::filesystem::path err_path = tmp.path() / "stderr.txt";
+    for (const long N : o.sizes) {
+        ScaleRow row;
+        row.N = N;
+        if (stopped_at && !o.keep_going) {
+            row.failure = fmt::format("skipped (N = {} did not finish)", *stopped_at);
+            rows.push_back(row);
+            continue;
+        }
+        CachedScene scene;
+        try {
+            const ForestSpec spec{N, o.density, o.lamps, o.seed};
+            scene = forest_scene(forest_stem(spec), spec);
+        } catch (const std::exception& e) {
+            row.failure = e.what();
+            row.stop = true;
+            stopped_at = N;
+            rows.push_back(row);
+            continue;
+        }
+        row.generate_s = scene.generate_s;
+        std::vector<double> load, solve, wall;
+        long rss = 0;
+        for (int r = 0; r < o.repeat; ++r) {
+            {
+                const auto t0 = Clock::now();
+                const flatrad::Scene s = flatrad::load_scene(scene.path.string());
+                load.push_back(seconds_since(t0));
+                row.patches = s.patches.size();
+            }
+            std::vector<std::string> args{flatrad.string(), "solve", scene.path.string(), "--method", "hierarchical",
+                                          "--eps", fmt::format("{}", o.eps)};
+            if (o.vis_eps) {
+                args.push_back("--vis-eps");
+                args.push_back(fmt::format("{}", *o.vis_eps));
+            }
+            for (const std::string& a : {std::string("--threads"), std::to_string(o.threads), std::string("-o"),
+                                         out_path.string(), std::string("--quiet")})
+                args.push_back(a);
+            fmt::print(stderr, "scale: N={} run {}/{} ...\n", N, r + 1, o.repeat);
+            std::error_code ec;
+            std::filesystem::remove(out_path, ec);
+            ChildOptions co;
+            co.stderr_path = err_path;
+            co.timeout_s = o.timeout_s;
+            co.max_memory_mib = o.max_memory_mib;
+            const ChildRun c = run_child(args, co);
+            rss = std::max(rss, c.max_rss_kib);
+            if (c.timed_out) {
+                row.failure = fmt::format("timed out after {} s (run {}/{}, RSS {:.0f} MiB)", o.timeout_s, r + 1,
+                                          o.repeat, static_cast<double>(c.max_rss_kib) / 1024.0);
+                row.stop = true;
+                break;
+            }
+            if (c.status != 0) {
+                const std::string why = last_line(err_path);
+                row.failure = fmt::format("flatrad exited with status {} (run {}/{}, RSS {:.0f} MiB){}{}", c.status,
+                                          r + 1, o.repeat, static_cast<double>(c.max_rss_kib) / 1024.0,
+                                          why.empty() ? "" : ": ", why);
+                row.stop = true;
+                break;
+            }
+            const nlohmann::json st = result_stats(out_path);
+            std::filesystem::remove(out_path, ec);
+            solve.push_back(st.at("time_s").get<double>());
+            wall.push_back(c.wall_s);
+            row.elements = st.at("elements").get<long>();
+            row.links = st.at("links").get<long>();
+            row.iterations = st.at("iterations").get<long>();
+            row.threads = st.at("threads").get<int>();
+            ++row.runs;
+            fmt::print(stderr, "scale: N={} run {}/{}: solve {:.3f} s, wall {:.3f} s, RSS {:.0f} MiB\n", N, r + 1,
+                       o.repeat, solve.back(), c.wall_s, static_cast<double>(c.max_rss_kib) / 1024.0);
+        }
+        row.load_s = median(load);
+        row.solve_s = median(solve);
+        row.wall_s = median(wall);
+        row.rss_mib = static_cast<double>(rss) / 1024.0;
+        if (row.stop) stopped_at = N;
+        rows.push_back(row);
+    }
+
+    fmt::print("\n{:>8} {:>8} {:>7} {:>4} {:>8} {:>9} {:>9} {:>10} {:>11} {:>6} {:>8} {:>3} {:>8} {:>8}\n", "N",
+               "patches", "gen_s", "runs", "load_s", "solve_s", "wall_s", "elements", "links", "iters", "RSS_MiB",
+               "thr", "t/NlogN", "exponent");
+    const ScaleRow* first = nullptr;
+    const ScaleRow* prev = nullptr;
+    std::vector<double> xs, ys;
+    auto nlogn = [](long N) { return static_cast<double>(N) * std::log2(static_cast<double>(N)); };
+    for (const ScaleRow& r : rows) {
+        const std::string gen = r.generate_s < 0 ? "cached" : fmt::format("{:.1f}", r.generate_s);
+        if (r.runs == 0) {
+            fmt::print("{:>8} {:>8} {:>7}  {}\n", r.N, r.patches ? std::to_string(r.patches) : "-",
+                       r.failure.rfind("skipped", 0) == 0 || r.patches == 0 ? "-" : gen, r.failure);
+            continue;
+        }
+        if (!first) first = &r;
+        const double norm = (r.solve_s / nlogn(r.N)) / (first->solve_s / nlogn(first->N));
+        std::string exponent = "-";
+        if (prev)
+            exponent = fmt::format("{:.2f}", std::log(r.solve_s / prev->solve_s) /
+                                                 std::log(static_cast<double>(r.N) / static_cast<double>(prev->N)));
+        fmt::print("{:>8} {:>8} {:>7} {:>4} {:>8.3f} {:>9.3f} {:>9.3f} {:>10} {:>11} {:>6} {:>8.1f} {:>3} {:>8.2f} "
+                   "{:>8}{}\n",
+                   r.N, r.patches, gen, r.runs, r.load_s, r.solve_s, r.wall_s, r.elements, r.links, r.iterations,
+                   r.rss_mib, r.threads, norm, exponent, r.failure.empty() ? "" : "  (then " + r.failure + ")");
+        prev = &r;
+        xs.push_back(static_cast<double>(r.N));
+        ys.push_back(r.solve_s);
+    }
+    if (const auto slope = log_log_slope(xs, ys); slope && xs.size() > 2)
+        fmt::print("\nexponent over all {} measured sizes (least squares on log solve_s against log N): {:.2f}\n",
+                   xs.size(), *slope);
+    std::fflush(stdout);
+}
+
+// ---------------------------------------------------------------------------
+// versus: the hierarchical solver against the exact one on the same scene.
+
+struct VersusOptions {
+    long elements = 4000;
+    std::vector<double> eps_list{2, 1, 0.5, 0.2, 0.1, 0.05, 0.02, 0.01};
+    long segments = 1000;
+    double density = 30;
+    int lamps = 1;
+    long seed = 1;
+    int repeat = 3;
+    int threads = 0;
+    bool reference_check = false;
+    bool all_eps = false;
+};
+
+constexpr double versus_error_goal = 0.01;
+constexpr double versus_speedup_goal = 100;
+
+void run_versus(VersusOptions o, const std::string& cmd) {
+    std::sort(o.eps_list.begin(), o.eps_list.end(), std::greater<>());
+    o.eps_list.erase(std::unique(o.eps_list.begin(), o.eps_list.end()), o.eps_list.end());
+    const ForestSpec spec{o.segments, o.density, o.lamps, o.seed};
+    const CachedScene cached = forest_scene(forest_stem(spec), spec);
+    const flatrad::Scene scene = flatrad::load_scene(cached.path.string());
+    const long P = static_cast<long>(scene.patches.size());
+    const int K = static_cast<int>(std::max(1L, std::lround(static_cast<double>(o.elements) / static_cast<double>(P))));
+
+    fmt::print("## versus: flatrad::solve_hierarchical against flatrad::solve_exact at K elements per patch "
+               "(in-process)\n");
+    fmt::print("command: {}\n", cmd);
+    fmt::print("scene: `scripts/make-scene {} --seed {} --density {} --lamps {}` ({}): {} segments, {} patches;\n"
+               "       K = round({} / patches) = {}: the exact mesh has {} elements.\n",
+               o.segments, o.seed, o.density, o.lamps, cached.path.string(), scene.segments.size(), P, o.elements,
+               K, P * K);
+    fmt::print("error: relative L2 over patch radiosities, length-weighted (compare_solutions, as `flatrad compare`),\n"
+               "       against the exact solver on this mesh of K elements per patch. That reference is itself a\n"
+               "       discretisation: this measures agreement with it, not with the true solution\n"
+               "       {}.\n"
+               "times: wall time of the call; exact once, hierarchical the median of {} run(s); threads {}.\n"
+               "       speed-up = exact / hierarchical.{}\n",
+               o.reference_check ? "(--reference-check: its own error, against 2K, is printed below, and rel_l2_2K is\n"
+                                   "       the hierarchical error against the 2K solution)"
+                                 : "(--reference-check estimates the reference's own error against 2K)",
+               o.repeat, o.threads > 0 ? std::to_string(o.threads) : fmt::format("all ({})", omp_get_max_threads()),
+               o.all_eps ? "" : "\n       Smaller eps are not run once a hierarchical run is slower than the exact "
+                                "one (--all-eps runs them).");
+    std::fflush(stdout);
+
+    fmt::print(stderr, "versus: exact, K = {} ({} elements) ...\n", K, P * K);
+    auto t0 = Clock::now();
+    const flatrad::Solution exact = flatrad::solve_exact(scene, {K, o.threads});
+    const double exact_s = seconds_since(t0);
+    fmt::print(stderr, "versus: exact: {:.3f} s\n", exact_s);
+    fmt::print("\nexact: K = {}, {} elements, {:.3f} s (form factors {:.3f} s, linear solve {:.3f} s), residual "
+               "{:.1e}\n",
+               K, exact.stats.elements, exact_s, exact.stats.form_factor_time_s, exact.stats.linear_solve_time_s,
+               exact.stats.residual);
+    std::optional<flatrad::Solution> fine;
+    if (o.reference_check) {
+        fmt::print(stderr, "versus: exact, 2K = {} ({} elements) ...\n", 2 * K, 2 * P * K);
+        t0 = Clock::now();
+        fine = flatrad::solve_exact(scene, {2 * K, o.threads});
+        const double fine_s = seconds_since(t0);
+        const flatrad::CompareError e = flatrad::compare_solutions(scene, exact, *fine);
+        fmt::print("reference check: exact at 2K = {} ({} elements, {:.3f} s): the K solution differs from it by\n"
+                   "       relative L2 {:.3e}, max relative {:.3e}: errors below about that are not resolved.\n",
+                   2 * K, fine->stats.elements, fine_s, e.relative_l2, e.max_relative);
+    }
+    std::fflush(stdout);
+
+    struct Row {
+        double eps = 0;
+        double time_s = 0;
+        long elements = 0, links = 0, iterations = 0;
+        flatrad::CompareError error, error_2K;
+        std::string failure;
+    };
+    std::vector<Row> rows;
+    std::optional<double> stopped_after;
+    for (const double eps : o.eps_list) {
+        Row row;
+        row.eps = eps;
+        if (stopped_after) break;
+        std::vector<double> times;
+        try {
+            flatrad::HierarchicalOptions h;
+            h.eps = eps;
+            h.threads = o.threads;
+            for (int r = 0; r < o.repeat; ++r) {
+                fmt::print(stderr, "versus: hierarchical eps {} run {}/{} ...\n", eps, r + 1, o.repeat);
+                t0 = Clock::now();
+                const flatrad::Solution sol = flatrad::solve_hierarchical(scene, h);
+                times.push_back(seconds_since(t0));
+                fmt::print(stderr, "versus: hierarchical eps {} run {}/{}: {:.3f} s\n", eps, r + 1, o.repeat,
+                           times.back());
+                if (r == 0) {
+                    row.elements = sol.stats.elements;
+                    row.links = sol.stats.links;
+                    row.iterations = sol.stats.iterations;
+                    row.error = flatrad::compare_solutions(scene, sol, exact);
+                    if (fine) row.error_2K = flatrad::compare_solutions(scene, sol, *fine);
+                }
+                if (times.back() > exact_s && !o.all_eps) break;  // no need for a median: slower than exact
+            }
+        } catch (const std::exception& e) {
+            row.failure = e.what();
+        }
+        row.time_s = median(times);
+        if (!o.all_eps && !times.empty() && row.time_s > exact_s) stopped_after = eps;
+        rows.push_back(row);
+    }
+
+    fmt::print("\n{:>8} {:>9} {:>10} {:>10} {:>6} {:>11} {:>11} {:>9} {:>6}{}\n", "eps", "time_s", "elements", "links",
+               "iters", "rel_l2", "max_rel", "speedup", "<=1%", fine ? fmt::format(" {:>11}", "rel_l2_2K") : "");
+    const Row* best = nullptr;
+    for (const Row& r : rows) {
+        if (!r.failure.empty()) {
+            fmt::print("{:>8g}  failed: {}\n", r.eps, r.failure);
+            continue;
+        }
+        const bool ok = r.error.relative_l2 <= versus_error_goal;
+        if (ok && !best) best = &r;
+        fmt::print("{:>8g} {:>9.3f} {:>10} {:>10} {:>6} {:>11.3e} {:>11.3e} {:>9.1f} {:>6}{}\n", r.eps, r.time_s,
+                   r.elements, r.links, r.iterations, r.error.relative_l2, r.error.max_relative, exact_s / r.time_s,
+                   ok ? "yes" : "no", fine ? fmt::format(" {:>11.3e}", r.error_2K.relative_l2) : "");
+    }
+    if (stopped_after)
+        fmt::print("(smaller eps than {} not run: it was slower than the exact solve; --all-eps runs them)\n",
+                   *stopped_after);
+    if (best)
+        fmt::print("\nlargest eps with relative L2 error <= {:g}%: eps = {:g} ({:.3e}), {:.3f} s against exact {:.3f} s: "
+                   "speed-up {:.1f}; goal >= {:g}x: {}{}\n",
+                   versus_error_goal * 100, best->eps, best->error.relative_l2, best->time_s, exact_s,
+                   exact_s / best->time_s, versus_speedup_goal,
+                   exact_s / best->time_s >= versus_speedup_goal ? "MET" : "NOT MET",
+                   best == &rows.front() ? "\n(the largest eps tried: a larger one may meet the error bound too)" : "");
+    else
+        fmt::print("\nno eps run reached a relative L2 error <= {:g}%: goal (>= {:g}x at <= 1%) NOT MET\n",
+                   versus_error_goal * 100, versus_speedup_goal);
+    std::fflush(stdout);
+}
+
+// ---------------------------------------------------------------------------
 
 int run(int argc, char** argv) {
-    if (argc < 2) throw UsageError("expected a command: rooms, ffcost, matrix or all (see --help)");
+    if (argc < 2) throw UsageError("expected a command: rooms, ffcost, matrix, scale, versus or all (see --help)");
     const std::string command = argv[1];
     const std::string cmd = command_line(argc, argv);
     if (command == "-h" || command == "--help") {
@@ -723,6 +1287,42 @@ int run(int argc, char** argv) {
         if (auto v = opt.get("--seed")) o.seed = static_cast<uint64_t>(parse_long(*v, "--seed", 0));
         o.sweep = opt.flags.count("--sweep-lengths") > 0;
         run_matrix(o, cmd);
+    } else if (command == "scale") {
+        const Options opt =
+            parse_options(argc, argv,
+                          {"--sizes", "--eps", "--vis-eps", "--repeat", "--density", "--lamps", "--seed", "--timeout",
+                           "--max-memory", "--threads"},
+                          {"--keep-going"});
+        ScaleOptions o;
+        if (auto v = opt.get("--lamps")) o.lamps = static_cast<int>(parse_long(*v, "--lamps", 1));
+        if (auto v = opt.get("--sizes")) o.sizes = parse_list(*v, "--sizes", 4 + o.lamps);
+        if (auto v = opt.get("--eps")) o.eps = parse_positive(*v, "--eps");
+        if (auto v = opt.get("--vis-eps")) o.vis_eps = parse_positive(*v, "--vis-eps");
+        if (auto v = opt.get("--repeat")) o.repeat = static_cast<int>(parse_long(*v, "--repeat", 1));
+        if (auto v = opt.get("--density")) o.density = parse_positive(*v, "--density");
+        if (auto v = opt.get("--seed")) o.seed = parse_long(*v, "--seed", 0);
+        if (auto v = opt.get("--timeout")) o.timeout_s = parse_positive(*v, "--timeout");
+        if (auto v = opt.get("--max-memory")) o.max_memory_mib = parse_long(*v, "--max-memory", 0);
+        if (auto v = opt.get("--threads")) o.threads = static_cast<int>(parse_long(*v, "--threads", 0));
+        o.keep_going = opt.flags.count("--keep-going") > 0;
+        run_scale(o, cmd);
+    } else if (command == "versus") {
+        const Options opt = parse_options(
+            argc, argv,
+            {"--elements", "--eps-list", "--segments", "--density", "--lamps", "--seed", "--repeat", "--threads"},
+            {"--reference-check", "--all-eps"});
+        VersusOptions o;
+        if (auto v = opt.get("--elements")) o.elements = parse_long(*v, "--elements", 1);
+        if (auto v = opt.get("--eps-list")) o.eps_list = parse_positive_list(*v, "--eps-list");
+        if (auto v = opt.get("--lamps")) o.lamps = static_cast<int>(parse_long(*v, "--lamps", 1));
+        if (auto v = opt.get("--segments")) o.segments = parse_long(*v, "--segments", 4 + o.lamps);
+        if (auto v = opt.get("--density")) o.density = parse_positive(*v, "--density");
+        if (auto v = opt.get("--seed")) o.seed = parse_long(*v, "--seed", 0);
+        if (auto v = opt.get("--repeat")) o.repeat = static_cast<int>(parse_long(*v, "--repeat", 1));
+        if (auto v = opt.get("--threads")) o.threads = static_cast<int>(parse_long(*v, "--threads", 0));
+        o.reference_check = opt.flags.count("--reference-check") > 0;
+        o.all_eps = opt.flags.count("--all-eps") > 0;
+        run_versus(o, cmd);
     } else if (command == "all") {
         parse_options(argc, argv, {}, {});
         run_ffcost({}, cmd + "  (= ffcost)");
@@ -733,7 +1333,7 @@ int run(int argc, char** argv) {
         rooms.large_size = 4000;
         run_rooms(rooms, cmd + "  (= rooms, with E = 4000 run once)");
     } else {
-        throw UsageError(fmt::format("{}: unknown command; expected rooms, ffcost, matrix or all", command));
+        throw UsageError(fmt::format("{}: unknown command; expected rooms, ffcost, matrix, scale, versus or all", command));
     }
     return 0;
 }

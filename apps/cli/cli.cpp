@@ -101,7 +101,8 @@ void add_solve(CLI::App& app, Commands& c) {
     cmd->add_option("--threads", a.threads, "Threads for the form factors; 0: all cores.")
         ->type_name("N")
         ->capture_default_str();
-    cmd->add_flag("-q,--quiet", a.quiet, "No summary on stderr.");
+    cmd->add_flag("-q,--quiet", a.quiet,
+                  "No summary on stderr, and no progress line (drawn only when stderr is a terminal).");
 }
 
 void add_formfactor(CLI::App& app, Commands& c) {

@@ -12,22 +12,14 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/atomic_write.h"
+#include "cli/progress.h"
 #include "cli/usage_error.h"
 #include "engine/error.h"
-#include "solver/exact_solver.h"
 #include "solver/hierarchical_solver.h"
 
 namespace flatrad {
 
 namespace {
-
-// The reference must be this many times more accurate than what it judges.
-constexpr double reference_margin = 10;
-// Below this, the K and 2K solutions agree to rounding (the dense LU's
-// residual is ~1e-15 relative, amplified by the conditioning, 1 / (1 - rho)
-// up to 1000 in a white furnace): a finer mesh cannot do better, so the
-// doubling stops there whatever the target.
-constexpr double rounding_floor = 1e-12;
 
 double max_of(const std::vector<double>& v) {
     double m = 0;
@@ -59,44 +51,6 @@ std::string sci(double v) { return std::isfinite(v) ? fmt::format("{:.3e}", v) :
 
 }  // namespace
 
-CompareError compare_solutions(const Scene& scene, const Solution& solution, const Solution& reference) {
-    FLATRAD_ASSERT(solution.patches.size() == scene.patches.size() &&
-                       reference.patches.size() == scene.patches.size(),
-                   "both solutions are of this scene");
-    const int C = scene.channels;
-    // Length-weighted sums, in long double: thousands of patches of
-    // very different brightness (a lamp beside shadows).
-    long double diff2 = 0, ref2 = 0, length = 0;
-    std::vector<long double> ref2_c(static_cast<size_t>(C), 0);
-    for (size_t p = 0; p < scene.patches.size(); ++p) {
-        const long double L = scene.patches[p].length;
-        length += L;
-        for (int c = 0; c < C; ++c) {
-            const long double r = reference.patches[p].radiosity[static_cast<size_t>(c)];
-            const long double d = solution.patches[p].radiosity[static_cast<size_t>(c)] - r;
-            diff2 += L * d * d;
-            ref2 += L * r * r;
-            ref2_c[static_cast<size_t>(c)] += L * r * r;
-        }
-    }
-    CompareError e;
-    const double inf = std::numeric_limits<double>::infinity();
-    e.relative_l2 = diff2 == 0 ? 0 : (ref2 > 0 ? static_cast<double>(std::sqrt(diff2 / ref2)) : inf);
-    for (size_t p = 0; p < scene.patches.size(); ++p)
-        for (int c = 0; c < C; ++c) {
-            const double rms = length > 0 ? static_cast<double>(std::sqrt(ref2_c[static_cast<size_t>(c)] / length)) : 0;
-            const double d = std::abs(solution.patches[p].radiosity[static_cast<size_t>(c)] -
-                                      reference.patches[p].radiosity[static_cast<size_t>(c)]);
-            const double rel = d == 0 ? 0 : (rms > 0 ? d / rms : inf);
-            if (e.worst_patch < 0 || rel > e.max_relative || std::isnan(rel)) {
-                e.max_relative = std::isnan(rel) ? inf : rel;
-                e.worst_patch = static_cast<int>(p);
-            }
-        }
-    if (e.max_relative == 0) e.worst_patch = -1;
-    return e;
-}
-
 CLI::App* add_compare_command(CLI::App& app, CompareArgs& a) {
     CLI::App* cmd = app.add_subcommand("compare", "Hierarchical against exact: error and run time, side by side.");
     cmd->footer(
@@ -125,7 +79,7 @@ CLI::App* add_compare_command(CLI::App& app, CompareArgs& a) {
         ->type_name("N")
         ->capture_default_str();
     cmd->add_option("--threads", a.threads, "Threads; 0: all cores.")->type_name("N")->capture_default_str();
-    cmd->add_flag("-q,--quiet", a.quiet, "No table on stderr.");
+    cmd->add_flag("-q,--quiet", a.quiet, "No table on stderr (and no progress line).");
     return cmd;
 }
 
@@ -144,78 +98,45 @@ int run_compare(const CompareArgs& args, std::ostream& out, std::ostream& err) {
 
     const Scene scene = load_scene(args.scene);
     const long patches = static_cast<long>(scene.patches.size());
-    auto fits = [&](long K) {
-        return patches * K <= args.max_elements && exact_solver_memory_bytes(scene, static_cast<int>(K)) <=
-                                                       exact_solver_memory_limit_bytes;
-    };
-    if (!fits(args.subdivide))
+    if (!reference_fits(scene, args.subdivide, args.max_elements))
         throw UsageError(fmt::format("--subdivide {}: {} patches x {} elements is beyond --max-elements {} or "
                                      "the exact solver's memory limit; use a smaller K",
                                      args.subdivide, patches, args.subdivide, args.max_elements));
 
-    // 1. Hierarchical.
+    // 1. Hierarchical, its progress drawn on a terminal (cli/progress.h).
     HierarchicalOptions h_options;
     h_options.eps = args.eps;
     h_options.vis_eps = args.vis_eps;
     h_options.threads = args.threads;
+    ProgressLine progress(err, !args.quiet && is_terminal_stderr(err));
+    if (progress.enabled()) h_options.progress = progress.callback("compare: hierarchical: ");
     const Solution hier = solve_hierarchical(scene, h_options);
+    progress.clear();
 
-    // 2-3. Exact at K and 2K, doubling K until the reference is good enough.
-    auto exact = [&](long K) {
-        if (!args.quiet) err << fmt::format("compare: exact solve, K = {} ({} elements)\n", K, patches * K) << std::flush;
-        ExactSolverOptions o;
-        o.subdivide = static_cast<int>(K);
-        o.threads = args.threads;
-        return solve_exact(scene, o);
-    };
+    // 2. The exact reference, refined until its own error is a tenth of the
+    // hierarchical one (cli/reference_solution.h).
+    ReferenceOptions r_options;
+    r_options.subdivide = args.subdivide;
+    r_options.max_elements = args.max_elements;
+    r_options.threads = args.threads;
+    if (!args.quiet)
+        r_options.on_solve = [&err](long K, long elements) {
+            err << fmt::format("compare: exact solve, K = {} ({} elements)\n", K, elements) << std::flush;
+        };
+    const Reference ref = solve_reference(scene, r_options, [&](const Solution& candidate) {
+        return compare_solutions(scene, hier, candidate).relative_l2;
+    });
+    const Solution& reference = ref.solution();
+    const long reference_K = ref.subdivide();
+    const CompareError h_err = compare_solutions(scene, hier, reference);
+    const double estimate = ref.error_estimate;
+    const bool reached = ref.reached;
     nlohmann::ordered_json steps = nlohmann::ordered_json::array();
-    long K = args.subdivide;
-    Solution coarse = exact(K), fine;
-    double exact_total_s = coarse.stats.time_s;
-    double estimate = std::numeric_limits<double>::infinity();
-    CompareError h_err;
-    CompareError last_pair;  // the last K solution against its 2K
-    last_pair.max_relative = std::numeric_limits<double>::quiet_NaN();
-    bool reached = false, have_fine = false;
-    std::string stopped;
-    while (true) {
-        if (!fits(2 * K)) {
-            stopped = fmt::format("K = {} ({} elements) would pass {}", 2 * K, patches * 2 * K,
-                                  patches * 2 * K > args.max_elements ? "--max-elements"
-                                                                      : "the exact solver's memory limit");
-            break;
-        }
-        fine = exact(2 * K);
-        have_fine = true;
-        exact_total_s += fine.stats.time_s;
-        last_pair = compare_solutions(scene, coarse, fine);
-        estimate = last_pair.relative_l2;
-        h_err = compare_solutions(scene, hier, fine);
-        steps.push_back({{"subdivide", K}, {"error_estimate", number(estimate)},
-                         {"hierarchical_relative_l2", number(h_err.relative_l2)}});
-        if (estimate <= h_err.relative_l2 / reference_margin) {
-            reached = true;
-            break;
-        }
-        if (estimate <= rounding_floor) {
-            stopped = fmt::format("the K and 2K exact solutions agree to rounding ({:g}); a finer mesh "
-                                  "cannot be more accurate",
-                                  rounding_floor);
-            break;
-        }
-        coarse = std::move(fine);
-        have_fine = false;
-        K *= 2;
-    }
-    // Without a 2K solve after the last doubling, the best solve is `coarse`.
-    const Solution& reference = have_fine ? fine : coarse;
-    const long reference_K = have_fine ? 2 * K : K;
-    if (!have_fine) h_err = compare_solutions(scene, hier, reference);
-    // The reference's own error, estimated from the last pair (an over-
-    // estimate when the reference is the finer of the two).
-    const CompareError& e_err = last_pair;
+    for (const ReferenceStep& s : ref.steps)
+        steps.push_back({{"subdivide", s.subdivide}, {"error_estimate", number(s.error_estimate)},
+                         {"hierarchical_relative_l2", number(s.compared_error)}});
 
-    // 4. Report.
+    // 3. Report.
     nlohmann::ordered_json j;
     j["flatrad"] = 1;
     j["scene"] = scene.name;
@@ -225,17 +146,17 @@ int run_compare(const CompareArgs& args, std::ostream& out, std::ostream& err) {
     h.update(run_json(hier));
     j["hierarchical"] = h;
     nlohmann::ordered_json x = {{"subdivide", reference_K}};
-    x["error"] = {{"relative_l2", number(estimate)}, {"max_relative", number(e_err.max_relative)},
+    x["error"] = {{"relative_l2", number(estimate)}, {"max_relative", number(ref.estimate_max_relative)},
                   {"estimated", true}};
     x.update(run_json(reference));
-    x["time_total_s"] = exact_total_s;
+    x["time_total_s"] = ref.time_total_s;
     j["exact"] = x;
     j["reference"] = {{"subdivide", reference_K},
                       {"error_estimate", number(estimate)},
-                      {"estimate_from_subdivide", have_fine ? K : (steps.empty() ? 0 : K / 2)},
+                      {"estimate_from_subdivide", ref.estimate_from_subdivide},
                       {"target", number(h_err.relative_l2 / reference_margin)},
                       {"reached", reached},
-                      {"stopped", stopped},
+                      {"stopped", ref.stopped},
                       {"steps", steps}};
     const std::string text = j.dump(2) + "\n";
     if (args.output.empty())
@@ -253,7 +174,7 @@ int run_compare(const CompareArgs& args, std::ostream& out, std::ostream& err) {
         err << fmt::format("  {:<22}{:>18}{:>22}\n", "relative L2 error", sci(h_err.relative_l2),
                            std::isfinite(estimate) ? "<= " + sci(estimate) + " (est.)" : "unknown");
         err << fmt::format("  {:<22}{:>18}{:>22}\n", "max relative error", sci(h_err.max_relative),
-                           std::isnan(e_err.max_relative) ? "?" : "<= " + sci(e_err.max_relative) + " (est.)");
+                           std::isnan(ref.estimate_max_relative) ? "?" : "<= " + sci(ref.estimate_max_relative) + " (est.)");
         err << fmt::format("  {:<22}{:>18}{:>22}\n", "energy balance", sci(max_of(hier.totals.balance)),
                            sci(max_of(reference.totals.balance)));
         err << fmt::format("  {:<22}{:>18}{:>22}\n", "time", fmt::format("{:.3g} s", hier.stats.time_s),
@@ -266,7 +187,7 @@ int run_compare(const CompareArgs& args, std::ostream& out, std::ostream& err) {
         else
             err << fmt::format("  reference NOT good enough: estimate {} > 1/10 of the hierarchical error {}; "
                                "stopped: {}\n",
-                               sci(estimate), sci(h_err.relative_l2), stopped);
+                               sci(estimate), sci(h_err.relative_l2), ref.stopped);
         if (!args.output.empty()) err << "  written to " << args.output << '\n';
         err << std::flush;
     }

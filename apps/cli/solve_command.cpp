@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "cli/atomic_write.h"
+#include "cli/progress.h"
 #include "cli/result_json.h"
 #include "cli/scene_svg.h"
 #include "cli/summary.h"
@@ -50,7 +51,12 @@ int run_solve(const SolveArgs& args, std::ostream& out, std::ostream& err) {
         if (args.eps) options.eps = *args.eps;
         if (args.vis_eps) options.vis_eps = *args.vis_eps;
         options.threads = args.threads;
+        // Progress on stderr when it is a terminal (cli/progress.h); erased
+        // before the summary, and on an exception by the destructor.
+        ProgressLine progress(err, !args.quiet && is_terminal_stderr(err));
+        if (progress.enabled()) options.progress = progress.callback("solve: ");
         solution = solve_hierarchical(scene, options);
+        progress.clear();
     } else {
         // Refused before any work when it would not fit (the message says how
         // much it would need); the flag is named when --subdivide is the cause.

@@ -16,7 +16,7 @@ struct SolveArgs {
     int subdivide = 1;                ///< elements per patch (exact), >= 1
     std::string svg;                  ///< picture of the solution; empty: none
     int threads = 0;                  ///< 0: all cores
-    bool quiet = false;               ///< no summary on stderr
+    bool quiet = false;               ///< no summary (nor progress line, cli/progress.h) on stderr
 };
 
 /// Validates `args` (throws UsageError), loads the scene (InputError),

@@ -21,6 +21,10 @@ constexpr double subtitle_char_width = 6.4;  // ~ 11 px sans-serif
 constexpr double tick_length = 5;
 constexpr double legend_char_width = 6.4;  // ~ average advance of 11 px sans-serif
 constexpr double point_radius = 2.4;
+// Point labels: smaller than the axis text, set off the point by about
+// twice its radius so that the text does not cover it.
+constexpr double point_label_font_px = 9;
+constexpr double point_label_offset = 5;
 
 // Mapped coordinates are kept within this many frame sizes of the frame:
 // anything beyond is clipped anyway, and huge numbers upset some renderers.
@@ -214,6 +218,9 @@ std::string render_svg_plot(const SvgPlot& plot) {
     for (const PlotSeries& s : plot.series) {
         if (s.x.size() != s.y.size())
             throw std::invalid_argument(fmt::format("svg plot: series \"{}\": x and y differ in length", s.label));
+        if (!s.point_labels.empty() && s.point_labels.size() != s.x.size())
+            throw std::invalid_argument(
+                fmt::format("svg plot: series \"{}\": point_labels and x differ in length", s.label));
         if (s.right_axis && !plot.y2)
             throw std::invalid_argument(fmt::format("svg plot: series \"{}\" is on a y2 axis the plot lacks", s.label));
     }
@@ -414,6 +421,15 @@ std::string render_svg_plot(const SvgPlot& plot) {
                 if (drawable(s.x[i], lx.scale) && drawable(s.y[i], l.scale))
                     fmt::format_to(out, "<circle cx=\"{}\" cy=\"{}\" r=\"{}\"/>\n", num(f.px(lx, s.x[i])),
                                    num(f.py(l, s.y[i])), point_radius);
+            svg += "</g>\n";
+        }
+        if (!s.point_labels.empty()) {
+            fmt::format_to(out, "<g fill=\"{}\" font-size=\"{}\">\n", s.color, point_label_font_px);
+            for (size_t i = 0; i < s.x.size(); ++i)
+                if (!s.point_labels[i].empty() && drawable(s.x[i], lx.scale) && drawable(s.y[i], l.scale))
+                    fmt::format_to(out, "<text x=\"{}\" y=\"{}\">{}</text>\n",
+                                   num(f.px(lx, s.x[i]) + point_label_offset), num(f.py(l, s.y[i]) - point_label_offset),
+                                   escape_xml(s.point_labels[i]));
             svg += "</g>\n";
         }
     }

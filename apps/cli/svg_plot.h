@@ -42,6 +42,11 @@ struct PlotSeries {
     std::string color = "#1f77b4";
     bool right_axis = false;  ///< plotted against y2 (the plot must have one)
     bool dashed = false;
+    /// Optional text beside each point (e.g. the eps it was run at): empty,
+    /// or one entry per point (an empty entry: no text there). Drawn up
+    /// and to the right of the point, small, in the series' colour, for
+    /// drawable points only.
+    std::vector<std::string> point_labels{};
 };
 
 /// The region between lo(x) and hi(x), shaded.
@@ -75,8 +80,8 @@ struct SvgPlot {
 
 /// The plot as a standalone SVG document (starts "<svg", ends "</svg>\n").
 /// Throws std::invalid_argument when a series' or band's arrays differ in
-/// length, when a right-axis item has no y2, or when a fixed log limit is
-/// not > 0. An axis with no drawable data gets limits [0, 1] (log: [1, 10]).
+/// length (a series' point_labels included, unless empty), when a
+/// right-axis item has no y2, or when a fixed log limit is not > 0. An axis with no drawable data gets limits [0, 1] (log: [1, 10]).
 std::string render_svg_plot(const SvgPlot& plot);
 
 /// Round tick values for a linear axis over [lo, hi]: about `target`

@@ -2,18 +2,22 @@
 
 
 #include <algorithm>
-#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <limits>
 #include <ostream>
 #include <system_error>
+#include <utility>
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
 #include "cli/atomic_write.h"
 #include "cli/formfactor_command.h"
+#include "cli/median.h"
+#include "cli/parse_whole.h"
+#include "cli/reference_solution.h"
+#include "cli/solution_sweep.h"
 #include "cli/svg_plot.h"
 #include "cli/usage_error.h"
 #include "engine/scene.h"
@@ -32,28 +36,9 @@ const char* const red = "#d62728";
 const char* const grey = "#7f7f7f";
 
 
-double median(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    const size_t n = v.size();
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
 GammaRule parse_gamma(const std::string& name) {
     if (const auto r = gamma_rule_from_name(name)) return *r;
     throw UsageError(fmt::format("--gamma {}: expected bound, bound-uniform, paper or line-space", name));
-}
-
-// A number that must fill the whole field (no trailing junk, no spaces).
-bool parse_whole(const std::string& s, double& v) {
-    const char* end = s.data() + s.size();
-    const auto [ptr, ec] = std::from_chars(s.data(), end, v);
-    return ec == std::errc() && ptr == end;
-}
-
-bool parse_whole(const std::string& s, long& v) {
-    const char* end = s.data() + s.size();
-    const auto [ptr, ec] = std::from_chars(s.data(), end, v);
-    return ec == std::errc() && ptr == end;
 }
 
 std::string one_line(std::string s) {
@@ -343,10 +328,11 @@ std::string sweep_csv(const Sweep& s, const std::string& scene_label, const std:
 
 CLI::App* add_sweep_command(CLI::App& app, SweepArgs& a) {
     CLI::App* cmd = app.add_subcommand(
-        "sweep", "Multi-scale form factor over a range of tolerances: error, bound and run time (CSV, SVG plots).");
-    cmd->footer(
-        "Computes the exact form factor from A to B (timed, median of --repeat runs), warms the cluster "
-        "tables (reported apart as precomputation), then the multiscale form factor at each eps, "
+        "sweep", "Error against run time over a range of tolerances: a multiscale form factor (--from/--to) or "
+                 "whole hierarchical solutions (CSV, SVG plots).");
+    cmd->footer(fmt::format(
+        "With --from A --to B: computes the exact form factor from A to B (timed, median of --repeat runs), warms "
+        "the cluster tables (reported apart as precomputation), then the multiscale form factor at each eps, "
         "--repeat times, keeping the median time. Writes a CSV table: a '#' comment line, then "
         "eps,F,F_exact,error,relative_error,error_bound,time_s,clusters_visited,clusters_approximated. "
         "With --svg PREFIX also PREFIX-time.svg (run time and clusters against eps, Soler 1995 Fig. 6), "
@@ -354,44 +340,100 @@ CLI::App* add_sweep_command(CLI::App& app, SweepArgs& a) {
         "PREFIX-error.svg (error against run time, log-log). A summary goes to stderr unless --quiet: "
         "the largest eps within 1% relative error, its time and speed-up, and how many eps had an error "
         "above the claimed bound. The default sweep (800 eps x 3 runs) takes a minute or more.\n"
-        "Exit status: 0 done; 2 bad input or bad arguments (one line on stderr); 1 anything else.");
+        "Without --from/--to: solves the scene hierarchically at each eps (--repeat times, median time; "
+        "--vis-eps fixed, or eps/10 for each eps), then one exact reference, K doubled from --subdivide until "
+        "its own error estimate (K against 2K) is at most 1/10 of the SMALLEST hierarchical error of the sweep "
+        "(or --max-elements or the exact solver's memory limit stops it, reported as reached false). Writes a "
+        "CSV table: '#' comment lines (the reference; every exact solve of the doubling, with its error "
+        "against the reference), then "
+        "eps,vis_eps,time_s,relative_l2,max_relative,balance,elements,links,iterations,reference_subdivide,"
+        "reference_time_s (errors over patch radiosities, length-weighted, all channels, as in compare). "
+        "With --svg PREFIX also PREFIX-error.svg (relative L2 error against run time, log-log, beside the exact "
+        "solver's own error and time) and PREFIX-eps.svg (errors and energy balance against eps). A table goes "
+        "to stderr unless --quiet, and a progress line while a solve runs when stderr is a terminal.\n"
+        "Exit status: 0 done; 2 bad input or bad arguments (one line on stderr); 1 anything else."));
     cmd->add_option("SCENE", a.scene, "Scene file (JSON).")->required()->type_name("FILE");
-    cmd->add_option("--from", a.from, "Sending surface name(s); several, separated by commas, form one group.")
-        ->required()
+    cmd->add_option_function<std::string>(
+           "--from", [&a](const std::string& v) { a.from = v; },
+           "Form-factor sweep: sending surface name(s); several, separated by commas, form one group. "
+           "Without --from and --to, whole solutions are swept.")
         ->type_name("A");
-    cmd->add_option("--to", a.to, "Receiving surface name(s), comma-separated as for --from.")
-        ->required()
+    cmd->add_option_function<std::string>(
+           "--to", [&a](const std::string& v) { a.to = v; },
+           "Form-factor sweep: receiving surface name(s), comma-separated as for --from.")
         ->type_name("B");
     cmd->add_option("--eps", a.eps,
-                    fmt::format("LO:HI:N: N tolerances linearly spaced from LO to HI, both included "
-                                "(0 <= LO <= HI, 1 <= N <= {}; N = 1 runs LO alone).",
-                                max_sweep_points))
-        ->type_name("LO:HI:N")
-        ->capture_default_str();
-    cmd->add_option("--gamma", a.gamma,
-                    "Multiscale criterion: bound (rigorous L1 line-space bound, the default), paper "
-                    "(Soler 1995's Gamma as written) or line-space (DESIGN's L2 variant).")
+                    fmt::format("Form-factor sweep: LO:HI:N, N tolerances linearly spaced from LO to HI, both "
+                                "included (0 <= LO <= HI, 1 <= N <= {}; N = 1 runs LO alone); default {}. "
+                                "Whole-solution sweep: a list E1,E2,..., or A:B:N (linear) or A:B:Nlog "
+                                "(log-spaced) from A to B, both included, every value > 0, "
+                                "1 <= N <= {}; default {} (7 values from 0.1 down to 1e-4).",
+                                max_sweep_points, default_form_factor_sweep_eps, max_solution_sweep_points,
+                                default_solution_sweep_eps))
+        ->type_name("SPEC");
+    cmd->add_option_function<std::string>(
+           "--gamma", [&a](const std::string& v) { a.gamma = v; },
+           "Form-factor sweep: the multiscale criterion: bound (rigorous L1 line-space bound, the default), "
+           "bound-uniform, paper (Soler 1995's Gamma as written) or line-space (DESIGN's L2 variant).")
         ->type_name("RULE")
-        ->check(CLI::IsMember({"bound", "bound-uniform", "paper", "line-space"}))
-        ->capture_default_str();
+        ->check(CLI::IsMember({"bound", "bound-uniform", "paper", "line-space"}));
     cmd->add_option("--repeat", a.repeat, "Runs per point, >= 1; times are medians.")
         ->type_name("R")
         ->capture_default_str();
+    cmd->add_option_function<double>(
+           "--vis-eps", [&a](const double& v) { a.vis_eps = v; },
+           "Whole-solution sweep: the hierarchical solver's visibility tolerance, >= 0, the same for every eps; "
+           "default: eps / 10 for each eps (the solver's default).")
+        ->type_name("E");
+    cmd->add_option_function<int>(
+           "--subdivide", [&a](const int& v) { a.subdivide = v; },
+           "Whole-solution sweep: K >= 1, the first reference mesh (elements per patch); default 16.")
+        ->type_name("K");
+    cmd->add_option_function<long>(
+           "--max-elements", [&a](const long& v) { a.max_elements = v; },
+           fmt::format("Whole-solution sweep: largest exact mesh tried (patches x K), >= 1; default {}; the exact "
+                       "solver's memory limit applies too.",
+                       default_reference_max_elements))
+        ->type_name("N");
+    cmd->add_option_function<int>(
+           "--threads", [&a](const int& v) { a.threads = v; },
+           "Whole-solution sweep: threads of both solvers; 0 (default): all cores.")
+        ->type_name("N");
     cmd->add_option("-o,--output", a.output,
                     "CSV file to write (atomically: a temporary file renamed). Without -o the table goes to stdout.")
         ->type_name("OUT.csv");
-    cmd->add_option("--svg", a.svg, "Also draw PREFIX-time.svg, PREFIX-F.svg and PREFIX-error.svg.")
+    cmd->add_option("--svg", a.svg,
+                    "Also draw plots: PREFIX-time.svg, PREFIX-F.svg and PREFIX-error.svg (form-factor sweep); "
+                    "PREFIX-error.svg and PREFIX-eps.svg (whole-solution sweep).")
         ->type_name("PREFIX");
-    cmd->add_flag("-q,--quiet", a.quiet, "No summary on stderr.");
+    cmd->add_flag("-q,--quiet", a.quiet, "No summary on stderr (and no progress line).");
     return cmd;
 }
 
 int run_sweep(const SweepArgs& args, std::ostream& out, std::ostream& err) {
+    // The mode: --from and --to together, or neither (whole solutions).
+    if (args.from.has_value() != args.to.has_value())
+        throw UsageError(fmt::format("{}: --from and --to go together (a form-factor sweep); give both, or neither "
+                                     "to sweep whole solutions",
+                                     args.from ? "--from without --to" : "--to without --from"));
+    if (!args.from) {
+        if (args.gamma) throw UsageError("--gamma: only for a form-factor sweep (--from A --to B)");
+        return run_solution_sweep_command(args, out, err);
+    }
+    for (const auto& [given, flag] : {std::pair{args.vis_eps.has_value(), "--vis-eps"},
+                                      std::pair{args.subdivide.has_value(), "--subdivide"},
+                                      std::pair{args.max_elements.has_value(), "--max-elements"},
+                                      std::pair{args.threads.has_value(), "--threads"}})
+        if (given)
+            throw UsageError(fmt::format("{}: only for a whole-solution sweep (without --from and --to)", flag));
+    const std::string& from_names = *args.from;
+    const std::string& to_names = *args.to;
+
     const auto t0 = std::chrono::steady_clock::now();
     // Arguments first: a typo must not cost a sweep.
-    const GammaRule rule = parse_gamma(args.gamma);
+    const GammaRule rule = parse_gamma(args.gamma.value_or("bound"));
     if (args.repeat < 1) throw UsageError(fmt::format("--repeat: expected an integer >= 1, got {}", args.repeat));
-    const std::vector<double> eps = parse_eps_range(args.eps);
+    const std::vector<double> eps = parse_eps_range(args.eps.empty() ? default_form_factor_sweep_eps : args.eps);
     if (!args.output.empty()) check_output_path(args.output, "-o");
     const std::vector<std::pair<std::string, std::string>> plots = {
         {"time", args.svg + "-time.svg"}, {"F", args.svg + "-F.svg"}, {"error", args.svg + "-error.svg"}};
@@ -399,12 +441,12 @@ int run_sweep(const SweepArgs& args, std::ostream& out, std::ostream& err) {
         for (const auto& [kind, path] : plots) check_output_path(path, "--svg");
 
     const Scene scene = load_scene(args.scene);
-    const std::vector<int> from = surface_group(scene, args.from, "--from");
-    const std::vector<int> to = surface_group(scene, args.to, "--to");
+    const std::vector<int> from = surface_group(scene, from_names, "--from");
+    const std::vector<int> to = surface_group(scene, to_names, "--to");
 
     if (!args.quiet)
         err << fmt::format("sweep: \"{}\", {} -> {}, gamma {}, {} eps in [{:.6g}, {:.6g}], median of {} run{}\n",
-                           one_line(scene.name), args.from, args.to, gamma_rule_name(rule), eps.size(), eps.front(),
+                           one_line(scene.name), from_names, to_names, gamma_rule_name(rule), eps.size(), eps.front(),
                            eps.back(), args.repeat, args.repeat == 1 ? "" : "s")
             << std::flush;
     const FormFactorContext context(scene);
@@ -412,7 +454,7 @@ int run_sweep(const SweepArgs& args, std::ostream& out, std::ostream& err) {
 
     // Outputs: the table, then the plots, each written whole or not at all.
     std::vector<std::string> written;
-    const std::string csv = sweep_csv(sweep, fmt::format("\"{}\" ({})", scene.name, scene.file), args.from, args.to);
+    const std::string csv = sweep_csv(sweep, fmt::format("\"{}\" ({})", scene.name, scene.file), from_names, to_names);
     if (args.output.empty()) {
         out << csv << std::flush;
     } else {
@@ -420,7 +462,7 @@ int run_sweep(const SweepArgs& args, std::ostream& out, std::ostream& err) {
         written.push_back(args.output);
     }
     if (!args.svg.empty()) {
-        const PlotContext c{one_line(scene.name), args.from, args.to, &sweep,
+        const PlotContext c{one_line(scene.name), from_names, to_names, &sweep,
                             *std::min_element(eps.begin(), eps.end()), *std::max_element(eps.begin(), eps.end())};
         for (const auto& [kind, path] : plots) {
             const SvgPlot p = kind == "time" ? time_plot(c) : kind == "F" ? value_plot(c) : error_plot(c);

@@ -1,10 +1,15 @@
 #pragma once
-/// `flatrad sweep` (SPEC.md, "Command line"; DESIGN.md §5): the multi-scale
-/// form factor between two groups of surfaces over a range of tolerances
-/// eps, each point's value, error against the exact form factor, claimed
-/// error bound, run time and clusters visited, as a CSV table and three SVG
-/// plots (Soler 1995, Fig. 6 and 7, and error against run time).
+/// `flatrad sweep` (SPEC.md, "Command line"; DESIGN.md §5), two modes:
+///  - with --from A --to B (this file): the multi-scale form factor between
+///    two groups of surfaces over a range of tolerances eps, each point's
+///    value, error against the exact form factor, claimed error bound, run
+///    time and clusters visited, as a CSV table and three SVG plots (Soler
+///    1995, Fig. 6 and 7, and error against run time);
+///  - without them: whole hierarchical solutions over a list of eps, each
+///    one's error against one exact reference beside its run time
+///    (cli/solution_sweep.h).
 ///
+/// Form-factor mode:
 /// The visibility structures are built once (FormFactorContext); the exact
 /// value is computed first; the lazily built cluster tables are then warmed
 /// by one query at the largest eps and one at the smallest positive eps, so
@@ -12,6 +17,7 @@
 /// reported apart, as "precomputation".
 #include <cstddef>
 #include <iosfwd>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -25,15 +31,23 @@ namespace flatrad {
 
 class FormFactorContext;
 
+/// Default --eps of the form-factor sweep (the paper's Fig. 6 and 7 range).
+inline constexpr const char* default_form_factor_sweep_eps = "0:0.04:800";
+
 struct SweepArgs {
     std::string scene;               ///< scene file
-    std::string from, to;            ///< comma-separated surface names
-    std::string eps = "0:0.04:800";  ///< LO:HI:N, N values from LO to HI inclusive
-    std::string gamma = "bound";     ///< bound, paper or line-space
+    std::optional<std::string> from, to;  ///< comma-separated surface names; both absent: whole-solution sweep
+    std::string eps;                 ///< the --eps spec; empty: the mode's default
+    std::optional<std::string> gamma;  ///< form-factor mode: bound (default), bound-uniform, paper or line-space
     int repeat = 3;                  ///< runs per point; times are medians
     std::string output;              ///< CSV file; empty: stdout
     std::string svg;                 ///< plot file prefix; empty: no plots
-    bool quiet = false;              ///< no summary on stderr
+    bool quiet = false;              ///< no summary (nor progress line) on stderr
+    // Whole-solution mode only (refused with --from/--to):
+    std::optional<double> vis_eps;   ///< fixed visibility tolerance; absent: eps / 10 for each eps
+    std::optional<int> subdivide;    ///< first reference K (default 16)
+    std::optional<long> max_elements;  ///< largest exact mesh (default default_reference_max_elements)
+    std::optional<int> threads;      ///< solver threads (default 0: all cores)
 };
 
 /// Largest N of an --eps spec: a sweep is meant to be drawn, and 1e5
@@ -95,10 +109,13 @@ std::string sweep_csv(const Sweep& sweep, const std::string& scene_label, const 
 /// Registers the `sweep` sub-command's flags on `app`, filling `args`.
 CLI::App* add_sweep_command(CLI::App& app, SweepArgs& args);
 
-/// Validates `args` (UsageError), loads the scene (InputError), sweeps,
-/// writes the CSV to args.output atomically (or to `out`) and, with
-/// args.svg, PREFIX-time.svg, PREFIX-F.svg and PREFIX-error.svg; then a
-/// summary on `err` unless args.quiet.
+/// Validates `args` (UsageError; --from without --to or the reverse, and a
+/// flag of the other mode, are refused), then runs the whole-solution sweep
+/// (run_solution_sweep_command, cli/solution_sweep.h) when both are absent.
+/// Form-factor mode: loads the scene (InputError), sweeps, writes the CSV
+/// to args.output atomically (or to `out`) and, with args.svg,
+/// PREFIX-time.svg, PREFIX-F.svg and PREFIX-error.svg; then a summary on
+/// `err` unless args.quiet.
 int run_sweep(const SweepArgs& args, std::ostream& out, std::ostream& err);
 
 }  // namespace flatrad

@@ -1,0 +1,100 @@
+#pragma once
+/// The exact reference an approximate solution is measured against
+/// (DESIGN.md §5, "how wrong": the error is only as good as its yardstick;
+/// DESIGN.md §3, "The reference solver"). Used by `flatrad compare` (one
+/// hierarchical solution) and `flatrad sweep` over whole solutions (many).
+///
+/// The reference must be much better than what it judges, so the exact
+/// solver's own discretisation error is estimated and driven down:
+///   1. solve exactly at K (ReferenceOptions::subdivide) and at 2K; the
+///      estimate of the K solution's error is the relative L2 distance
+///      between the two (cli/solution_error.h), and the compared error is
+///      measured against the 2K solution;
+///   2. while the estimate exceeds 1/reference_margin of the compared error,
+///      double K (the old 2K solve is reused) and go to 1 -- unless the
+///      next 2K would exceed the exact solver's memory limit
+///      (exact_solver_memory_bytes) or max_elements, or the estimate is at
+///      rounding level (reference_rounding_floor: K and 2K agree, a finer
+///      mesh cannot do better); then the last solve is the reference with
+///      `reached` false and `stopped` saying why.
+/// The estimate is that of the K solution; the 2K reference used is
+/// usually better still (its error shrinks with K), so the estimate is
+/// conservative. The compared error is a function of the candidate, so a
+/// caller judging several solutions passes the smallest of their errors:
+/// the reference is then good enough for every one of them.
+#include <functional>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "engine/scene.h"
+#include "solver/solution.h"
+
+namespace flatrad {
+
+/// The reference must be this many times more accurate than what it judges
+/// (a tenth: the judged error is then right to about 10%, one digit).
+inline constexpr double reference_margin = 10;
+
+/// Below this estimate the K and 2K solutions agree to rounding (the dense
+/// LU's residual is ~1e-15 relative, amplified by the conditioning,
+/// 1 / (1 - rho) up to 1000 in a white furnace): a finer mesh cannot do
+/// better, so the doubling stops there whatever the target.
+inline constexpr double reference_rounding_floor = 1e-12;
+
+/// Default largest mesh: a dense LU of 8000 unknowns is ~3e11 flops and
+/// 1.5 GB (three matrices), a minute or two on a small machine; the exact
+/// solver's own memory limit (8 GiB) would allow ~19000, hours of work.
+inline constexpr long default_reference_max_elements = 8000;
+
+struct ReferenceOptions {
+    int subdivide = 16;                                   ///< first K, >= 1
+    long max_elements = default_reference_max_elements;   ///< largest mesh (patches x K) tried, >= 1
+    int threads = 0;                                      ///< 0: all cores
+    /// Called before each exact solve with its K and its elements
+    /// (patches x K), e.g. to log it; may be empty.
+    std::function<void(long K, long elements)> on_solve;
+};
+
+/// Whether an exact solve at K fits: patches x K <= max_elements and within
+/// the exact solver's memory limit.
+bool reference_fits(const Scene& scene, long K, long max_elements);
+
+/// One K -> 2K doubling of step 1.
+struct ReferenceStep {
+    long subdivide = 0;          ///< K
+    double error_estimate = 0;   ///< relative L2 of the K solution against the 2K one
+    double compared_error = 0;   ///< the compared error against the 2K solution
+};
+
+struct Reference {
+    /// Every exact solve, coarse to fine (K, 2K, 4K, ...); the last one is
+    /// the reference. Kept so that callers can draw the exact solver's own
+    /// error against its run time.
+    std::vector<Solution> ladder;
+    std::vector<long> ladder_subdivide;  ///< K of each ladder entry
+    /// Relative L2 (and max relative) of the last pair's coarser solve
+    /// against its finer; +inf (NaN) when no pair was solved.
+    double error_estimate = std::numeric_limits<double>::infinity();
+    double estimate_max_relative = std::numeric_limits<double>::quiet_NaN();
+    long estimate_from_subdivide = 0;  ///< K of that coarser solve; 0 when none
+    bool reached = false;              ///< error_estimate <= compared error / reference_margin
+    std::string stopped;               ///< why the doubling stopped short; empty when reached
+    std::vector<ReferenceStep> steps;
+    double time_total_s = 0;           ///< all exact solves together
+
+    const Solution& solution() const { return ladder.back(); }
+    long subdivide() const { return ladder_subdivide.back(); }
+};
+
+/// Builds the reference for `scene` as above. `compared_error(candidate)`
+/// is the error being judged, measured against a candidate reference (for
+/// one solution S: compare_solutions(scene, S, candidate).relative_l2).
+/// Pre: reference_fits(scene, options.subdivide, options.max_elements)
+/// (throws std::invalid_argument otherwise: callers check it first, with
+/// a message naming their own flags). Exceptions of the exact solver
+/// (InputError for a scene it refuses) pass through.
+Reference solve_reference(const Scene& scene, const ReferenceOptions& options,
+                          const std::function<double(const Solution& candidate)>& compared_error);
+
+}  // namespace flatrad

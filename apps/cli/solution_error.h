@@ -1,0 +1,30 @@
+#pragma once
+/// How far one solution of a scene is from another, taken as the reference
+/// (DESIGN.md §5: "relative L2 over patches, length-weighted; L-infinity").
+/// Used by `flatrad compare` and by `flatrad sweep` over whole solutions.
+///
+/// Errors are over patches (their length-weighted mean radiosity), all
+/// channels, each patch weighted by its length L_p:
+///   relative_l2  = sqrt(sum_pc L_p (B_pc - R_pc)^2 / sum_pc L_p R_pc^2),
+///   max_relative = max_pc |B_pc - R_pc| / rms_c, rms_c the length-weighted
+///                  RMS of the reference's channel c (so a dark patch's
+///                  error counts at the scale of the scene, not of itself).
+/// Both are 0 when the solutions agree, and 0 (not NaN) for an all-dark
+/// reference that is matched exactly; +inf for a mismatch against it.
+#include "engine/scene.h"
+#include "solver/solution.h"
+
+namespace flatrad {
+
+struct CompareError {
+    double relative_l2 = 0;
+    double max_relative = 0;
+    int worst_patch = -1;  ///< where max_relative is reached; -1 when none
+};
+
+/// Errors of `solution` against `reference`, two solves of `scene` (same
+/// patches, same channels), as above. Meshes may differ: only the patches'
+/// mean radiosities are compared.
+CompareError compare_solutions(const Scene& scene, const Solution& solution, const Solution& reference);
+
+}  // namespace flatrad
