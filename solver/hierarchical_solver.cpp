@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 
 #include "engine/compensated_sum.h"
+#include "engine/connectivity.h"
 #include "engine/convex_scene.h"
 #include "engine/error.h"
 #include "engine/formfactor.h"
@@ -18,6 +19,8 @@
 #include "solver/directional.h"
 #include "solver/gmres.h"
 #include "solver/reachability.h"
+#include "solver/rooms.h"
+#include "solver/sink_visibility.h"
 #include "visibility/cluster_tables.h"
 #include "visibility/exact_visibility.h"
 #include "visibility/multiscale.h"
@@ -52,6 +55,8 @@ struct Node {
     int32_t segment = -1;       // elements and sinks
     int32_t table = -1;         // clusters: index of the directional tables
     int16_t depth = 0;          // elements: level below the patch
+    uint64_t send_rooms = 0;    // rooms its light can leave into (solver/rooms.h)
+    uint64_t recv_rooms = 0;    // rooms it can receive from
     Segment seg;                // elements and sinks: oriented, lit (or receiving) side on the left
     Vec2 normal;                // elements and sinks: unit normal of that side
     Vec2 center;
@@ -111,7 +116,17 @@ public:
           m_vis(m_hierarchy, m_tables) {
         m_threads = o.threads > 0 ? o.threads : omp_get_max_threads();
         m_vis_eps = o.vis_eps >= 0 ? o.vis_eps : o.eps / 10;
+
         m_unblockable = no_segment_can_block(scene);
+        const Connectivity conn = scene_connectivity(scene);
+        m_escape_free = escape_free_patches(scene, conn);
+        m_visible_sink = visible_sinks(scene, conn);
+        m_side_room = side_rooms(scene, conn);
+        const bool sinks = std::find(m_visible_sink.begin(), m_visible_sink.end(), 1) != m_visible_sink.end();
+        // Row sums of 1 hold for escape-free patches when no sink can be seen.
+        m_closed_patch.assign(scene.patches.size(), 0);
+        if (!sinks)
+            for (size_t p = 0; p < scene.patches.size(); ++p) m_closed_patch[p] = m_escape_free[p];
     }
 
     Solution run();
@@ -148,6 +163,7 @@ private:
     void apply_G(const Eigen::VectorXd& x, Eigen::VectorXd& out, bool correct);
     void solve();
     std::vector<double> leaf_guess() const;
+    std::vector<double> landed_fraction() const;
 
     const Scene& m_scene;
     HierarchicalOptions m_opt;
@@ -155,6 +171,7 @@ private:
     int m_threads = 1;
     double m_vis_eps = 0;
     bool m_unblockable = false;
+
     Hierarchy m_hierarchy;
     ClusterTables m_tables;
     MultiscaleVisibility m_vis;
@@ -176,6 +193,9 @@ private:
     // ancestors' part of that sum; 0 for leaves not known to be closed.
     std::vector<double> m_deficit, m_anc_sum;
     std::vector<char> m_closed_patch;
+    std::vector<char> m_escape_free;   // per patch (engine/connectivity.h)
+    std::vector<char> m_visible_sink;  // per segment side (solver/sink_visibility.h)
+    std::vector<int> m_side_room;      // per segment side (solver/rooms.h)
 
     // Scratch for the operator.
     std::vector<double> m_Bn, m_I, m_Hn, m_J, m_Ha;
@@ -271,6 +291,7 @@ void HierarchicalSolver::build_tree() {
             const SceneSegment& ss = m_scene.segments[static_cast<size_t>(s)];
             for (int side = 0; side < 2; ++side) {
                 const bool lit = side == 0 ? ss.lit_left : ss.lit_right;
+                if (!lit && !m_visible_sink[2 * static_cast<size_t>(s) + static_cast<size_t>(side)]) continue;
                 Node n;
                 n.parent = id;
                 n.hnode = h;
@@ -280,6 +301,7 @@ void HierarchicalSolver::build_tree() {
                 n.center = n.seg.midpoint();
                 n.length = ss.seg.length();
                 n.radius = 0.5 * n.length;
+                n.recv_rooms = room_mask(m_side_room[2 * static_cast<size_t>(s) + static_cast<size_t>(side)]);
                 if (lit) {
                     n.kind = Kind::Element;
                     const int p = (first_patch[static_cast<size_t>(s)] >= 0 &&
@@ -308,10 +330,13 @@ void HierarchicalSolver::build_tree() {
             bool any = false;
             for (int c = 0; c < m_C; ++c) any = any || rho(static_cast<int>(k), c) > 0 || emission(static_cast<int>(k), c) > 0;
             n.can_send = any;
+            n.send_rooms = any ? n.recv_rooms : 0;
         }
         if (n.parent < 0) continue;
         Node& p = m_nodes[static_cast<size_t>(n.parent)];
         p.can_send = p.can_send || n.can_send;
+        p.send_rooms |= n.send_rooms;
+        p.recv_rooms |= n.recv_rooms;
         if (p.table >= 0) {
             double* dst = &m_sensitivity[static_cast<size_t>(p.table) * K];
             if (n.table >= 0) {
@@ -383,6 +408,10 @@ bool HierarchicalSolver::make_link(int r, int s, Link& l, ExactWorkspace& ws, Vi
     const Node& nr = m_nodes[static_cast<size_t>(r)];
     const Node& ns = m_nodes[static_cast<size_t>(s)];
     if (r == s) return true;  // a cluster's self link: always split, carries nothing itself
+    if ((ns.send_rooms & nr.recv_rooms) == 0) {  // a closed loop between them (solver/rooms.h)
+        ++st.culled;
+        return false;
+    }
     if (!nr.cluster() && !ns.cluster()) {
         const double Fu = form_factor_unoccluded(nr.seg, ns.seg);
         if (!(Fu > 0)) {
@@ -444,6 +473,17 @@ bool HierarchicalSolver::make_link(int r, int s, Link& l, ExactWorkspace& ws, Vi
     l.sbin = bin_of(u);
     l.rbin = bin_of(-u);
     l.geo = static_cast<float>(2 * reach / dist);
+    // Unoccluded coefficient (tau = 1).
+    double coef_u = 0;
+    if (!nr.cluster()) {
+        // Angle r subtends from the sender's centre.
+        const Vec2 a = nr.seg.a - ns.center, b = nr.seg.b - ns.center;
+        coef_u = std::abs(std::atan2(cross(a, b), dot(a, b))) / nr.length;
+    } else if (!ns.cluster()) {
+        coef_u = 0.5 * ns.length * std::max(0.0, dot(ns.normal, u)) / dist;
+    } else {
+        coef_u = 1 / dist;
+    }
     double tau = 1, terr = 0;
     if (!m_unblockable) {
         const TransmittanceResult t = m_vis.transmittance(nr.hnode, ns.hnode, m_vis_eps, GammaRule::Bound, ws, st);
@@ -455,17 +495,7 @@ bool HierarchicalSolver::make_link(int r, int s, Link& l, ExactWorkspace& ws, Vi
     if (!(tau > 0) && terr == 0) return false;
     l.tau = static_cast<float>(tau);
     l.vis_err = static_cast<float>(terr);
-    if (!nr.cluster()) {
-        // Angle r subtends from the sender's centre (only its part in front).
-        const Vec2 a = nr.seg.a - ns.center, b = nr.seg.b - ns.center;
-        const double delta = std::abs(std::atan2(cross(a, b), dot(a, b)));
-        l.coef = tau * delta / nr.length;
-    } else if (!ns.cluster()) {
-        const double c = std::max(0.0, dot(ns.normal, u));
-        l.coef = tau / dist * 0.5 * ns.length * c;
-    } else {
-        l.coef = tau / dist;
-    }
+    l.coef = tau * coef_u;
     return true;
 }
 
@@ -960,6 +990,54 @@ void HierarchicalSolver::solve() {
     m_solve_time += seconds_since(t0);
 }
 
+// Per node: the fraction of the power its element leaves send that the
+// links deliver anywhere (to patches or sinks): the adjoint of pull and
+// gather (DESIGN.md §3). A link delivers lambda = coef x (receiver length,
+// or the receiver cluster's sensitivity at the arrival direction) per unit
+// of its sender value; an element sender's value is its length-weighted mean
+// B (so lambda / L_s per unit of power sent below it), a cluster sender's is
+// its exitance table read at the link's direction (so the table's adjoint,
+// pushed down the clusters and read through each side's cosine lobe, / 2).
+std::vector<double> HierarchicalSolver::landed_fraction() const {
+    const size_t N = m_nodes.size();
+    std::vector<double> own(N, 0.0), lam(static_cast<size_t>(m_tables_count) * K, 0.0);
+    for (const Link& l : m_links) {
+        const Node& r = m_nodes[static_cast<size_t>(l.r)];
+        const Node& s = m_nodes[static_cast<size_t>(l.s)];
+        const double d = l.coef * (r.cluster() ? interpolate(&m_sensitivity[static_cast<size_t>(r.table) * K], l.rbin) : r.length);
+        if (s.cluster()) {
+            double* t = &lam[static_cast<size_t>(s.table) * K];
+            t[l.sbin.k] += (1 - l.sbin.t) * d;
+            t[l.sbin.next()] += l.sbin.t * d;
+        } else {
+            own[static_cast<size_t>(l.s)] += d / s.length;
+        }
+    }
+    std::vector<double> omega(N, 0.0);
+    for (size_t k = 0; k < N; ++k) {
+        const Node& n = m_nodes[k];
+        if (n.parent < 0) continue;
+        const Node& p = m_nodes[static_cast<size_t>(n.parent)];
+        if (n.cluster()) {
+            if (n.table >= 0 && p.table >= 0) {
+                double* dst = &lam[static_cast<size_t>(n.table) * K];
+                const double* src = &lam[static_cast<size_t>(p.table) * K];
+                for (int b = 0; b < K; ++b) dst[b] += src[b];
+            }
+            continue;
+        }
+        double from_above = 0;
+        if (p.cluster()) {
+            if (p.parent >= 0 && m_nodes[static_cast<size_t>(p.parent)].table >= 0)
+                from_above = 0.5 * read_cosine_lobe(&lam[static_cast<size_t>(m_nodes[static_cast<size_t>(p.parent)].table) * K], n.normal);
+        } else {
+            from_above = omega[static_cast<size_t>(n.parent)];
+        }
+        omega[k] = from_above + own[k];
+    }
+    return omega;
+}
+
 Solution HierarchicalSolver::run() {
     const auto t_start = Clock::now();
     refuse_closed_white();
@@ -1021,11 +1099,16 @@ Solution HierarchicalSolver::run() {
             pr.radiosity.push_back(m_B[static_cast<size_t>(c)][static_cast<size_t>(patch_root[p])]);  // pulled mean
     }
 
-    // Totals: absorbed by patches ((1 - rho) H) and sinks; escaped = sent - landed.
+    // Totals: absorbed by patches ((1 - rho) H) and sinks. Escaped: what the
+    // links do not deliver of the power sent by patches whose light can
+    // leave the scene (not escape-free, engine/connectivity.h). What the
+    // escape-free ones lose is the solver's own error and shows as balance;
+    // in a scene with no escape-free patch, balance only checks the solve.
+    const std::vector<double> omega = m_links.empty() ? std::vector<double>(m_nodes.size(), 1.0) : landed_fraction();
     for (int c = 0; c < m_C; ++c) {
         const auto& B = m_B[static_cast<size_t>(c)];
         const auto& H = m_H[static_cast<size_t>(c)];
-        CompensatedSum emitted, absorbed, sent, landed;
+        CompensatedSum emitted, absorbed, escaped;
         for (size_t k = 0; k < m_nodes.size(); ++k) {
             const Node& n = m_nodes[k];
             if (n.child >= 0 || n.cluster()) continue;
@@ -1033,14 +1116,13 @@ Solution HierarchicalSolver::run() {
             if (n.kind == Kind::Element) {
                 emitted.add(L * emission(static_cast<int>(k), c));
                 absorbed.add(L * (1 - rho(static_cast<int>(k), c)) * H[k]);
-                sent.add(L * B[k]);
+                if (!m_escape_free[static_cast<size_t>(n.patch)]) escaped.add(L * B[k] * (1 - omega[k]));
             } else {
                 absorbed.add(L * H[k]);
             }
-            landed.add(L * H[k]);
         }
         const double em = emitted.value(), ab = absorbed.value();
-        double es = sent.value() - landed.value();
+        double es = escaped.value();
         if (std::abs(es) <= 1e-12 * std::max(em, ab)) es = 0;
         sol.totals.emitted.push_back(em);
         sol.totals.absorbed.push_back(ab);

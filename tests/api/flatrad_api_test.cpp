@@ -89,7 +89,9 @@ TEST_CASE("api: polygons, circles, three channels and the hierarchical solver") 
 
     api::SolveOptions options;
     options.method = api::Method::Hierarchical;
-    options.eps = 1e-2;
+    // 1e-3: the clustered solver's energy error on this closed room is
+    // 6.8e-2 at eps 1e-2 and 4e-3 at 1e-3 (README, "Hierarchical").
+    options.eps = 1e-3;
     const api::Result h = api::solve(scene, options);
     CHECK(h.method == "hierarchical");
     CHECK(h.patch_count() == scene.patch_count());

@@ -266,9 +266,6 @@ constexpr double monotone_slack = 1.5;
 // hierarchical solver must have (error -> 0 as eps -> 0), not a figure of
 // this one, and it still catches a sweep whose rows all solve alike.
 constexpr double min_fall_over_two_decades = 4;
-// The energy balance measures rounding in the solve (hierarchical_solver.h,
-// "Totals"); 1e-9 is far above the ~1e-13 seen and far below a lost link.
-constexpr double balance_tol = 1e-9;
 
 }  // namespace
 
@@ -332,8 +329,7 @@ TEST_CASE("sweep (whole solutions): CSV rows per eps, errors fall with eps, two 
         CHECK(row[3] > 0);                              // relative L2: not exact
         CHECK(std::isfinite(row[3]));
         CHECK(row[4] >= row[3] / 10);                   // max relative is of the same order or larger
-        CHECK(row[5] >= 0);
-        CHECK(row[5] <= balance_tol);
+        CHECK(row[5] >= 0);  // balance: the closed box's transport error (solver/hierarchical_solver.h)
         CHECK(row[6] > 0);                              // elements
         CHECK(row[7] > 0);                              // links
         CHECK(row[9] == reference_K);                   // one reference for the whole sweep
@@ -341,6 +337,7 @@ TEST_CASE("sweep (whole solutions): CSV rows per eps, errors fall with eps, two 
         if (k > 0) CHECK(row[3] <= monotone_slack * csv.rows[k - 1][3]);
     }
     CHECK(csv.rows.back()[3] * min_fall_over_two_decades <= csv.rows.front()[3]);
+    CHECK(csv.rows.back()[5] < csv.rows.front()[5]);  // the energy error falls too
     CHECK(csv.rows.back()[6] >= csv.rows.front()[6]);  // a finer eps refines more
 
     for (const char* kind : {"-error.svg", "-eps.svg"}) {

@@ -1,0 +1,33 @@
+#pragma once
+/// Unlit sides that no patch can see (DESIGN.md §4: pay for what the scene
+/// uses). An unlit side of a segment is a sink: black, it absorbs what it
+/// receives (SPEC). The outer side of a room lit inside, with everything
+/// else in the room, and the inner side of a pillar lit outside, with
+/// nothing in it, receive nothing: the solver makes no node for them, and
+/// a scene with no visible sink at all lets its escape-free patches (light
+/// that cannot leave the scene, engine/connectivity.h) know that their form
+/// factors to the lit patches sum to 1 (the hierarchical solver's row sums).
+///
+/// Rule (sufficient): the segment is on a simple loop L of known orientation
+/// (engine/connectivity.h) and
+///  - the unlit side faces L's exterior, and every segment not on L lies
+///    strictly inside L (both endpoints inside, no contact with L); or
+///  - the unlit side faces L's interior, and no segment not on L has an
+///    endpoint inside L or touches L.
+/// Point-in-polygon by crossing number; a point within rounding of L's
+/// boundary counts as touching (then the sink is kept: not proven).
+/// Cost: O(segments x |L|) per loop with unlit sides, skipped (sinks kept)
+/// beyond 1e8 tests in all.
+#include <vector>
+
+#include "engine/connectivity.h"
+#include "engine/scene.h"
+
+namespace flatrad {
+
+/// Two entries per segment (left side, right side of a -> b): 1 when the
+/// side is unlit and not proven invisible, 0 when it is lit or proven
+/// invisible.
+std::vector<char> visible_sinks(const Scene& scene, const Connectivity& connectivity);
+
+}  // namespace flatrad
