@@ -81,7 +81,7 @@
 namespace flatrad {
 
 struct HierarchicalOptions {
-    double eps = 1e-2;       ///< relative refinement tolerance (see above), > 0
+    double eps = 3e-3;       ///< relative refinement tolerance (see above), > 0; 3e-3: ~1% error
     double vis_eps = -1;     ///< absolute tolerance on F for visibility; < 0: eps / 10
     int max_depth = 12;      ///< deepest element level (a patch is level 0)
     int max_passes = 8;      ///< refine-solve rounds at most

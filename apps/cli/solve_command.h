@@ -10,7 +10,7 @@ namespace flatrad {
 struct SolveArgs {
     std::string scene;                ///< scene file
     std::string output;               ///< result file; empty: stdout
-    std::string method = "exact";     ///< "exact" or "hierarchical"
+    std::string method = "hierarchical";  ///< "hierarchical" (SPEC's default) or "exact"
     std::optional<double> eps;        ///< hierarchical refinement tolerance
     std::optional<double> vis_eps;    ///< hierarchical visibility tolerance
     int subdivide = 1;                ///< elements per patch (exact), >= 1

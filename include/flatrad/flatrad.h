@@ -174,8 +174,8 @@ enum class Method {
 };
 
 struct SolveOptions {
-    Method method = Method::Exact;
-    double eps = 1e-2;     ///< Hierarchical: relative refinement tolerance, > 0 and finite
+    Method method = Method::Hierarchical;
+    double eps = 3e-3;     ///< Hierarchical: relative refinement tolerance, > 0 and finite (3e-3: ~1% error)
     double vis_eps = -1;   ///< Hierarchical: visibility tolerance on F, >= 0; < 0: eps / 10
     int subdivide = 1;     ///< Exact: elements per patch, >= 1
     int threads = 0;       ///< OpenMP threads for form factors, >= 0; 0: every core

@@ -51,6 +51,7 @@ TEST_CASE("api: a built scene solves exactly like the same scene read from its f
     CHECK(built.surface_names() == std::vector<std::string>{"floor", "walls"});
 
     api::SolveOptions options;
+    options.method = api::Method::Exact;
     options.subdivide = 3;
     const api::Result a = api::solve(built, options);
     const api::Result b = api::solve(read, options);
@@ -97,7 +98,9 @@ TEST_CASE("api: polygons, circles, three channels and the hierarchical solver") 
     CHECK(h.patch_count() == scene.patch_count());
     CHECK(h.patches[4].side == api::Side::Right);
     CHECK(h.patches[5].side == api::Side::Out);
-    const api::Result e = api::solve(scene);
+    api::SolveOptions exact_options;
+    exact_options.method = api::Method::Exact;
+    const api::Result e = api::solve(scene, exact_options);
     for (int c = 0; c < 3; ++c) {
         const auto k = static_cast<std::size_t>(c);
         CHECK(h.emitted[k] == doctest::Approx(e.emitted[k]));
@@ -141,6 +144,7 @@ TEST_CASE("api: bad scenes are refused at build() with the JSON path a file woul
 TEST_CASE("api: solve options are checked") {
     const api::Scene scene = closed_box().build();
     api::SolveOptions options;
+    options.method = api::Method::Exact;
     options.subdivide = 0;
     check_input_error([&] { api::solve(scene, options); }, "box.json", "subdivide");
     options = {};

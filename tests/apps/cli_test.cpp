@@ -176,7 +176,7 @@ TEST_CASE("cli: bad scene files give status 2 and one line naming file and path"
 TEST_CASE("cli: solve writes the SPEC result file to stdout") {
     TempDir tmp;
     const std::string scene = tmp.file("room.json", lit_room);
-    const Run r = run({"solve", scene, "--subdivide", "3"});
+    const Run r = run({"solve", scene, "--method", "exact", "--subdivide", "3"});
     REQUIRE(r.status == 0);
     const json result = json::parse(r.out);  // stdout is pure JSON
     CHECK(r.err.find("lit room") != std::string::npos);  // summary on stderr
@@ -294,7 +294,7 @@ TEST_CASE("cli: --subdivide too large for memory is refused with the size") {
     TempDir tmp;
     const std::string scene = tmp.file("room.json", lit_room);
     // 6 patches x 100000 = 6e5 elements: 6e5^2 x 8 bytes = 2.6 TiB.
-    const Run r = run({"solve", scene, "--subdivide", "100000"});
+    const Run r = run({"solve", scene, "--method", "exact", "--subdivide", "100000"});
     CHECK(r.status == 2);
     CHECK(is_one_error_line(r.err));
     CHECK(r.err.find("GiB") != std::string::npos);
@@ -355,7 +355,7 @@ TEST_CASE("cli: solve the data/ scenes closed_box and uniform_box") {
     // to ~1e-13 (exact solver), so the balance is far below 1e-10.
     constexpr double closed_balance_tol = 1e-10;
     {
-        const Run r = run({"solve", data + "/closed_box.json", "-q"});
+        const Run r = run({"solve", data + "/closed_box.json", "--method", "exact", "-q"});
         REQUIRE(r.status == 0);
         const json result = json::parse(r.out);
         const json& patches = result["patches"];
@@ -370,7 +370,7 @@ TEST_CASE("cli: solve the data/ scenes closed_box and uniform_box") {
     {
         // Emission 1, reflectance 0.5, closed: B = E / (1 - rho) = 2 on every
         // element; the closure error (~1e-13) is amplified by 1 / (1 - rho) = 2.
-        const Run r = run({"solve", data + "/uniform_box.json", "--subdivide", "4", "-q"});
+        const Run r = run({"solve", data + "/uniform_box.json", "--subdivide", "4", "--method", "exact", "-q"});
         REQUIRE(r.status == 0);
         const json result = json::parse(r.out);
         for (const json& patch : result["patches"])

@@ -109,7 +109,7 @@ void interrupt_solve(int sig) {
 
     const pid_t child = fork_child([&] {
         std::ostringstream out, err;
-        return flatrad::run_cli({"solve", scene.string(), "-o", result.string(), "--subdivide", "20",
+        return flatrad::run_cli({"solve", scene.string(), "-o", result.string(), "--method", "exact", "--subdivide", "20",
                                  "--threads", "1", "-q"},
                                 out, err);
     });
