@@ -1,6 +1,8 @@
 #include "engine/convex_scene.h"
 
 #include <algorithm>
+#include <cmath>
+#include <numbers>
 #include <vector>
 
 namespace flatrad {
@@ -38,20 +40,40 @@ bool no_segment_can_block(const Scene& scene) {
         pts.push_back(s.seg.b);
     }
     const std::vector<Vec2> hull = convex_hull(pts);
-    if (static_cast<double>(hull.size()) * static_cast<double>(scene.segments.size()) > 1e8) return false;
+    if (hull.size() < 3) return false;  // all collinear: collinear segments face nothing anyway, but say "unsure"
+    // A segment is on the boundary when its line supports the hull: for its
+    // unit normal n (either sign), max over the hull of n . v equals n . a.
+    // The maximising vertex is found by binary search on the hull's outward
+    // edge normals, whose angles increase around a counter-clockwise hull
+    // (O(log H) per segment, O(N log N) in all).
+    const size_t H = hull.size();
+    std::vector<double> angle(H);
+    for (size_t i = 0; i < H; ++i) {
+        const Vec2 e = hull[(i + 1) % H] - hull[i];
+        angle[i] = std::atan2(-e.x, e.y);  // outward normal (e rotated clockwise)
+        if (i > 0)
+            while (angle[i] < angle[i - 1]) angle[i] += 2 * std::numbers::pi;
+    }
+    auto support = [&](Vec2 n) {
+        double t = std::atan2(n.y, n.x);
+        while (t < angle[0]) t += 2 * std::numbers::pi;
+        while (t >= angle[0] + 2 * std::numbers::pi) t -= 2 * std::numbers::pi;
+        // Vertex j = first edge whose normal angle >= t: edges j-1 and j bracket n.
+        const size_t j = static_cast<size_t>(std::lower_bound(angle.begin(), angle.end(), t) - angle.begin()) % H;
+        double best = dot(n, hull[j]);
+        // Neighbours too: the angles are rounded.
+        best = std::max({best, dot(n, hull[(j + 1) % H]), dot(n, hull[(j + H - 1) % H])});
+        return best;
+    };
     const double extent = scene.extent();
-    // A segment is on the boundary when no hull vertex lies on one side of
-    // its line while another lies on the other (all hull vertices on one
-    // side: the line supports the hull, and both endpoints are on it).
     for (const SceneSegment& s : scene.segments) {
-        const double tol = 1e-12 * s.seg.length() * extent;
-        bool left = false, right = false;
-        for (const Vec2& v : hull) {
-            const double o = orient(s.seg.a, s.seg.b, v);
-            left = left || o > tol;
-            right = right || o < -tol;
-            if (left && right) return false;
-        }
+        const double L = s.seg.length();
+        if (!(L > 0)) return false;
+        const Vec2 n = rot90(s.seg.b - s.seg.a) / L;
+        const double tol = 1e-12 * extent;
+        const double h = dot(n, s.seg.a);
+        const bool supports = support(n) <= h + tol || support(-n) <= -h + tol;
+        if (!supports) return false;
     }
     return true;
 }

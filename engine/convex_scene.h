@@ -14,8 +14,8 @@ namespace flatrad {
 
 /// True when every segment of `scene` lies on its convex hull's boundary
 /// (within a relative 1e-12 of the extent, for coordinates read from text).
-/// Conservative: false when unsure, including when the check would cost
-/// more than ~1e8 orientation tests (hull vertices x segments).
+/// Conservative: false when unsure. O(N log N): the hull, then a binary
+/// search of each segment's supporting direction among the hull's edges.
 bool no_segment_can_block(const Scene& scene);
 
 }  // namespace flatrad

@@ -151,3 +151,24 @@ TEST_CASE("hierarchical solver: converges to the exact solver as eps shrinks") {
         }
     }
 }
+
+TEST_CASE("hierarchical solver: pays for what the scene uses (DESIGN.md §4)") {
+    // A closed convex room: nothing can block, so no visibility query at all.
+    const Scene convex = parse_scene(R"({"flatrad": 1, "materials": {"w": {"reflectance": 0.6},
+        "lamp": {"emission": 1}}, "surfaces": [
+        {"name": "lamp", "material": "lamp", "points": [[0,0],[1,0]], "side": "left"},
+        {"name": "walls", "material": "w", "points": [[1,0],[2,0.5],[2,2],[0.5,2.5],[-0.5,1],[0,0]], "side": "left"}]})",
+                                     "convex.json");
+    const Solution a = solve_hierarchical(convex);
+    CHECK(a.stats.visibility.queries == 0);
+    CHECK(a.stats.visibility.unoccluded > 0);
+    CHECK(a.stats.links > 0);
+    // The same room with a plate inside asks for visibility.
+    const Scene blocked = parse_scene(R"({"flatrad": 1, "materials": {"w": {"reflectance": 0.6},
+        "lamp": {"emission": 1}}, "surfaces": [
+        {"name": "lamp", "material": "lamp", "points": [[0,0],[1,0]], "side": "left"},
+        {"name": "walls", "material": "w", "points": [[1,0],[2,0.5],[2,2],[0.5,2.5],[-0.5,1],[0,0]], "side": "left"},
+        {"name": "plate", "material": "w", "points": [[0.4,1],[1.2,1.1]], "side": "both"}]})",
+                                      "blocked.json");
+    CHECK(solve_hierarchical(blocked).stats.visibility.queries > 0);
+}
