@@ -191,7 +191,7 @@ private:
     // Row sums (see the header): per leaf, the deficit 1 - (sum of what its
     // own and its ancestors' links deliver for B = 1 everywhere), and the
     // ancestors' part of that sum; 0 for leaves not known to be closed.
-    std::vector<double> m_deficit, m_anc_sum;
+    std::vector<double> m_deficit, m_anc_sum, m_own_sum;
     std::vector<char> m_closed_patch;
     std::vector<char> m_escape_free;   // per patch (engine/connectivity.h)
     std::vector<char> m_visible_sink;  // per segment side (solver/sink_visibility.h)
@@ -929,8 +929,14 @@ void HierarchicalSolver::apply_G(const Eigen::VectorXd& x, Eigen::VectorXd& out,
     for (size_t i = 0; i < static_cast<size_t>(m_element_leaves); ++i) {
         const size_t k = static_cast<size_t>(m_leaves[i]);
         double h = m_Hn[k] + m_Ha[k];
-        if (correct && !m_deficit.empty() && m_deficit[i] != 0 && m_anc_sum[i] > 0)
-            h += m_deficit[i] * m_Ha[k] / m_anc_sum[i];
+        // The deficit goes with the ancestors' arrivals (where the
+        // refinement error is); a leaf with none scales its own links.
+        if (correct && !m_deficit.empty() && m_deficit[i] != 0) {
+            if (m_anc_sum[i] > 0)
+                h += m_deficit[i] * m_Ha[k] / m_anc_sum[i];
+            else if (m_own_sum[i] > 0)
+                h += m_deficit[i] * m_Hn[k] / m_own_sum[i];
+        }
         out(static_cast<Eigen::Index>(i)) = h;
     }
 }
@@ -945,6 +951,7 @@ void HierarchicalSolver::solve() {
     // that sees no sink must gather exactly 1 for B = 1 everywhere.
     m_deficit.assign(static_cast<size_t>(n), 0.0);
     m_anc_sum.assign(static_cast<size_t>(n), 0.0);
+    m_own_sum.assign(static_cast<size_t>(n), 0.0);
     if (!m_closed_patch.empty()) {
         Eigen::VectorXd ones = Eigen::VectorXd::Ones(n), g;
         apply_G(ones, g, false);
@@ -953,6 +960,7 @@ void HierarchicalSolver::solve() {
             if (!m_closed_patch[static_cast<size_t>(m_nodes[static_cast<size_t>(node)].patch)]) continue;
             m_deficit[static_cast<size_t>(i)] = 1 - g(i);
             m_anc_sum[static_cast<size_t>(i)] = m_Ha[static_cast<size_t>(node)];
+            m_own_sum[static_cast<size_t>(i)] = m_Hn[static_cast<size_t>(node)];
         }
     }
     m_B.assign(static_cast<size_t>(m_C), std::vector<double>(m_nodes.size(), 0.0));

@@ -1,77 +1,74 @@
 #pragma once
-/// Hierarchical radiosity WITHOUT clustering (Hanrahan, Salzman, Aupperle,
-/// "A rapid hierarchical radiosity algorithm", SIGGRAPH 1991; DESIGN.md §3):
-/// a first slice of the solver DESIGN §3 describes. Clustering (links above
-/// the patches) and directional cluster models are not done yet.
+/// Hierarchical radiosity with clustering (DESIGN.md §3; Hanrahan, Salzman,
+/// Aupperle 1991; Smits, Arvo, Greenberg 1994; Sillion 1995).
 ///
-///  - Elements: each patch is the root of a binary tree of elements, a node
-///    split at the middle of its parameter. Unlit sides of segments (sinks:
-///    black, SPEC) get receive-only trees of their own, so that the power
-///    they absorb is gathered like any other.
-///  - Links: initially one per ordered pair of patches (and patch -> sink)
-///    that can see each other's lit side (clip_to_lit_halfplanes). A link
-///    (receiver r, sender s) carries F_rs from MultiscaleVisibility
-///    (GammaRule::Bound, tolerance vis_eps on F; an empty shaft costs only
-///    crossed strings, counted in stats.visibility.unoccluded), the element's
-///    parent segment numbers skipped as blockers.
+///  - One tree: the scene's cluster hierarchy (engine/hierarchy.h, one
+///    segment per leaf), under each leaf the two sides of its segment (a
+///    patch, the root of a binary element tree, or a sink: an unlit side,
+///    black, receive-only), elements split at their middle on demand.
+///    Sinks that no patch can see get no node (solver/sink_visibility.h).
+///  - Links between any two nodes, created top-down: the root's self link
+///    is split into its children's pairs and self links, and so on; a link
+///    to a hierarchy leaf goes to its sides. A link (receiver r, sender s):
+///      element <- element: F_rs, the exact average over r, from
+///        MultiscaleVisibility with --vis-eps (absolute on F);
+///      anything <- cluster, cluster <- element: point approximations at
+///        the nodes' centres, times the transmittance between the two
+///        hierarchy nodes (MultiscaleVisibility::transmittance, --vis-eps on
+///        tau); a link whose shaft holds no blocker never calls visibility,
+///        and a scene where no segment can block (engine/convex_scene.h)
+///        calls it never;
+///      nodes in different rooms (solver/rooms.h: a closed loop between
+///        them) get no link.
+///  - Directional model (solver/directional.h): a cluster's exitance
+///    I(phi) = sum (B L / 2) cos+ and its irradiance arrivals J(psi) are
+///    tables of 32 directions, read and written by linear interpolation; an
+///    element under a cluster reads its cosine lobe from J. Each cluster
+///    also has its sensitivity N(psi) = sum L cos+ (power received per unit
+///    arrival density).
 ///  - Refinement oracle: a link is split when its estimated error in
-///    transported power exceeds eps_abs (below); the side split is the
-///    longer one (the other when that one is at max_depth). The estimate is
-///      err = B_s * L_r * (kernel + occlusion + visibility),
-///    (no reflectance factor: of what r receives, rho goes into B_r and
-///    1 - rho into the absorbed totals, so an error matters either way;
-///    weighting by rho left a black lamp's links coarse and lost 2.5% of
-///    the absorbed power of data/default.json), B_s = the sender's largest
-///    channel in the current solution (the initial patch-to-patch links are
-///    solved first, so no a-priori bound on B is needed), and
-///      kernel     = variation of the unoccluded F over quarters of r and of
-///                   s (mean |F(r_k -> s) - F(r -> s)| and
-///                   sum |F(r -> s_k) - F(r -> s) / 4|): catches ends-vs-
-///                   middle variation that halves miss by symmetry;
-///      occlusion  = min(F, F_unoccluded - F): a partly hidden sender may put
-///                   a shadow boundary anywhere on the link;
-///      visibility = the multiscale error bound on F;
-///    plus L_r F_rs |B_s0 - B_s1| / 2 when the sender already has children
-///    s0, s1 (split by other links): the link spreads the sender's mean.
-///  - eps is RELATIVE: eps_abs = eps * W / N, W = sum over patches of
-///    L_p * max-channel B_p (the scene's exitant power, current solution)
-///    and N the number of patches: one link may misplace at most the
-///    fraction eps of an average patch's exitant power. Refine, solve and
-///    refine again until no link splits (at most max_passes passes).
-///  - Solve: matrix-free operator on the leaf radiosities, per channel:
-///    pull (length-weighted B up the trees), gather (each node collects
-///    sum over its links F * B_sender), push (irradiance down to the leaves),
-///    B = E + rho * H; the system (I - rho G) B = E is solved by restarted
-///    GMRES (Saad & Schultz 1986) to a relative residual of 1e-12.
-///    stats.iterations counts operator applications over all channels.
-///  - Row sums: links at different levels make a leaf's sum of F over its
-///    own and its ancestors' links differ from the true value by the
-///    refinement error, and 1 / (1 - rho) amplifies that (1000x in a white
-///    furnace at 0.999). For a patch whose root links to lit patches sum to
-///    1 (within the visibility bounds + 1e-9) and that sees no sink, the true
-///    row sum is 1 at every point. A leaf's own links are exact averages
-///    over it; the error is in its ancestors' links, mostly in those whose
-///    F varies over the receiver (near neighbours, shadows). So a leaf gets
-///    its deficit d = 1 - (sum of F over its own and ancestors' links)
-///    times the mean radiosity of its ancestors' senders weighted by each
-///    link's receiver-side variation w = L_r (kernel + occlusion). (Scaling
-///    the whole row, or all ancestor links evenly, puts the deficit on a
-///    bright lamp: measured 5x worse on a shadowed box.) Other patches
-///    (seeing a sink or an opening) are left as they are; as eps -> 0,
-///    d -> 0.
-///  - Pay for what is used: a scene that emits nothing gets no links (B = 0);
-///    one-channel scenes carry one channel; an empty shaft costs crossed
-///    strings only. Not done yet: skipping surfaces no emitter reaches.
+///    transported power exceeds eps_abs = eps x W / N (W the scene's exitant
+///    power in the current solution, max over channels; N the patch count:
+///    eps is RELATIVE, one link may misplace at most eps of an average
+///    patch's power). Element links: as the first slice (kernel variation
+///    over quarters, min(F, F_u - F) for a shadow boundary, the visibility
+///    bound, the sender's unevenness). Cluster links: unoccluded power x
+///    (point approximation 2 rho / d per clustered side, the tables'
+///    interpolation error from their second differences, layers hidden
+///    inside a cluster: sensitivity beyond the box's width, min(tau, 1 -
+///    tau), the visibility bound); the side with the larger share is split.
+///    Overlapping nodes (d <= rho_r + rho_s, or an element whose line cuts
+///    the cluster's box) are always split when they carry light. The first
+///    round refines against a guess (every patch at E + rho B_bar, B_bar
+///    the radiosity of a closed room with the scene's emission and
+///    absorption), then refine, solve, refine until no link splits.
+///  - Solve: per channel, the matrix-free operator on the element leaves:
+///    pull (means up the element trees, exitance tables up the clusters),
+///    gather along the links (in parallel over receivers), push (tables
+///    down the clusters, cosine lobes onto the sides, irradiance down the
+///    elements); (I - rho G) B = E by restarted GMRES (solver/gmres.h) to
+///    1e-12. stats.iterations counts operator applications.
+///  - Row sums: a leaf whose light cannot leave the scene
+///    (engine/connectivity.h) in a scene where no sink can be seen must
+///    gather exactly 1 for B = 1 everywhere; its deficit (the refinement
+///    error of its ancestors' links, amplified 1 / (1 - rho) in a white
+///    furnace) is added in proportion to what its ancestors' links bring.
+///  - Pay for what is used: light-flow reachability over the links
+///    (solver/reachability.h, Boost.Graph BFS): links whose sender no
+///    emitter's light reaches are dropped, patches none of whose leaves is
+///    reached are counted in stats.patches_left_out; a scene that emits
+///    nothing gets no links; one-channel scenes carry one channel.
+///  - Totals: absorbed = sum over leaves of L (1 - rho) H plus what sinks
+///    gather. Escaped: what the links do not deliver (the adjoint of pull
+///    and gather gives each leaf's delivered fraction) of the power sent by
+///    patches whose light can leave the scene. What escape-free patches
+///    lose is the transport's own energy error: balance = |emitted -
+///    absorbed - escaped| / emitted measures it (in a scene with no
+///    escape-free patch, balance only checks the linear solve).
+///    Measured on data/default.json: 4.6e-2 at eps 1e-2, 5.7e-3 at 1e-3,
+///    1.5e-4 at 1e-4, 8e-5 at 3e-5.
 ///  - Refuses (InputError) a closed set of reflectance-1 patches without
-///    absorber, as solve_exact does (checked with exact patch form factors,
-///    only when some reflectance is 1).
-///  - Totals: absorbed = sum over leaves of L (1 - rho) H plus the power
-///    gathered by sinks; escaped = power sent minus power landing through
-///    links (the links of a fully refined tree cover each pair of leaves
-///    once), so balance measures the linear solve only. The real energy
-///    error shows as `escaped` in a closed scene (the links spread a
-///    sender's mean B, not its leaves' values): 1e-3 of the emitted power
-///    on data/default.json at eps = 1e-3, 9e-3 at eps = 1e-2.
+///    absorber, as solve_exact does.
 #include <functional>
 #include <string>
 
