@@ -10,6 +10,7 @@
 #include <memory>
 #include <numbers>
 #include <optional>
+#include <set>
 #include <sstream>
 #include <string_view>
 #include <system_error>
@@ -325,6 +326,481 @@ Json parse_json(const std::string& text, const std::string& file) {
     DomBuilder builder(root, file, text);
     Json::sax_parse(text, &builder);
     return root;
+}
+
+// ---- overlapping segments ---------------------------------------------------
+
+/// Largest |coordinate| of a segment's endpoints.
+double magnitude(const Segment& g) {
+    return std::max({std::abs(g.a.x), std::abs(g.a.y), std::abs(g.b.x), std::abs(g.b.y)});
+}
+
+/// Points off a line by a few ulps of the coordinates are on it; a sliver
+/// 3 wide at 1e15 (24 ulps) is real geometry and is kept.
+constexpr double overlap_rounding = 4 * std::numeric_limits<double>::epsilon();
+
+/// The refusal rule for one ordered pair, g before h in SPEC order: h lies
+/// on g's line (both ends within rounding of it) and overlaps g over more
+/// than rounding. Returns the overlap length, or nothing. Only g's line is
+/// tested (the rule is not symmetric at the level of rounding), so callers
+/// pass the earlier segment first.
+std::optional<double> lies_on(const Segment& g, const Segment& h) {
+    const double L = g.length();
+    const double tol =
+        overlap_rounding * (std::max(magnitude(g), magnitude(h)) + std::max(L, h.length()));
+    // On g's line (distance within rounding) ...
+    if (std::abs(orient(g.a, g.b, h.a)) > tol * L || std::abs(orient(g.a, g.b, h.b)) > tol * L) return {};
+    // ... and overlapping it over more than rounding.
+    const Vec2 d = (g.b - g.a) / L;
+    const double u0 = dot(h.a - g.a, d), u1 = dot(h.b - g.a, d);
+    const double overlap = std::min(L, std::max(u0, u1)) - std::max(0.0, std::min(u0, u1));
+    if (overlap <= tol) return {};
+    return overlap;
+}
+
+/// Finds the first segment s (in SPEC order) on which some later segment t
+/// lies (lies_on(s, t)), in O(N log N) for any arrangement that is not
+/// itself within a few ulps of such an overlap.
+///
+/// A bounding-box search (every segment against the boxes it touches) is
+/// quadratic for long slanted segments: the boxes of a venetian blind of
+/// parallel diagonal slats, or of a fan of rays, all overlap one another.
+/// What lies_on needs is much narrower, and that is what is searched:
+///
+///  1. Bounds. Let T = 4 eps (largest |coordinate| + longest segment): no
+///     pair's tolerance exceeds it. Allowing for the rounding of orient and
+///     dot (about 3 eps |u| |v| and 6 eps |v|, |v| <= 2.9 x largest
+///     |coordinate|), lies_on(s, t) implies, exactly:
+///      - both ends of t within 3.3 T of s's line, so the two directions
+///        differ by at most asin(6.5 T / |t|) (undirected, modulo a half
+///        turn); window() bounds that, from above, for either length;
+///      - some point of t within 5.5 T of segment s.
+///  2. Directions. Segments are put in length classes (floor(log2 length):
+///     at most 56, since lengths span less than 2e16) and, within a class,
+///     sorted by direction in [0, pi) and cut into groups spanning at most
+///     4 T / 2^class radians. In a frame turned to its group's mean
+///     direction every member is within 4 T of horizontal end to end: the
+///     group is a set of thin, nearly horizontal segments there, held in a
+///     cluster hierarchy (engine/hierarchy.h) when it has more than a few.
+///  3. Queries. For s, in SPEC order, each class is searched over the
+///     directions within max(window(|s|), window(2^class)) of s's (binary
+///     search over the groups' direction ranges, wrapping at pi), and each
+///     group found over the box of s, turned into the group's frame and
+///     padded by 16 T (5.5 T plus the rounding of both turns). Every t > s
+///     found there is tested with lies_on itself. The first s with a hit ends
+///     the search.
+///
+/// Nothing that lies_on would refuse is left out: each filter is implied by
+/// it, with margins above the rounding. Parallel families (walls of a
+/// Manhattan scene, slats, collinear chains) are separated by the hierarchy
+/// of their group, different directions by the direction search. What is
+/// searched in vain: pairs within about 16 T of lying on each other, and,
+/// for a segment much longer than a class, that class's segments within its
+/// window of parallel and within (its length x that window) of its line.
+/// Only near-degenerate scenes have those in numbers.
+class OverlapFinder {
+public:
+    explicit OverlapFinder(const std::vector<Segment>& segments) : m_segments(segments) {
+        const size_t n = segments.size();
+        double largest = 0, longest = 0;
+        m_length.resize(n);
+        m_angle.resize(n);
+        for (size_t i = 0; i < n; ++i) {
+            const Segment& g = segments[i];
+            m_length[i] = g.length();
+            largest = std::max(largest, magnitude(g));
+            longest = std::max(longest, m_length[i]);
+            // Undirected direction in [0, pi).
+            double angle = std::atan2(g.b.y - g.a.y, g.b.x - g.a.x);
+            if (angle < 0) angle += std::numbers::pi;
+            if (angle >= std::numbers::pi) angle -= std::numbers::pi;
+            m_angle[i] = angle;
+        }
+        m_T = overlap_rounding * (largest + longest);
+        build();
+    }
+
+    /// The first s (SPEC order) with a later t that lies on it, and the
+    /// first such t; nothing if no segment lies on another.
+    std::optional<std::pair<size_t, size_t>> first() const {
+        std::vector<int32_t> stack;
+        for (size_t s = 0; s < m_segments.size(); ++s) {
+            size_t partner = m_segments.size();
+            visit_candidates(s, stack, [&](size_t t) {
+                if (t > s && t < partner && lies_on(m_segments[s], m_segments[t])) partner = t;
+            });
+            if (partner < m_segments.size()) return std::pair{s, partner};
+        }
+        return std::nullopt;
+    }
+
+private:
+    /// Marks a direction window that takes in every direction.
+    static constexpr double any_direction = std::numbers::pi / 2;
+
+    struct Group {
+        double angle_lo = 0, angle_hi = 0;  // members' directions (sorted)
+        double cos = 1, sin = 0;            // the frame: turned by -(mean direction)
+        size_t begin = 0, end = 0;          // members are m_members[begin, end)
+        int tree = -1;                      // index into m_trees, or -1: scan the members
+    };
+    struct Class {
+        double window = 0;  // window() of the class's shortest possible length
+        size_t begin = 0, end = 0;  // its groups, m_groups[begin, end), by direction
+    };
+
+    /// Upper bound on how far the direction of a segment of this length may
+    /// be from that of a segment it lies on or that lies on it (step 1):
+    /// asin(z) <= 1.05 z for z <= 0.5, plus the rounding of atan2.
+    double window(double length) const {
+        const double z = 8 * m_T / length;
+        return z >= 0.5 ? any_direction : 1.2 * z + 16 * std::numeric_limits<double>::epsilon();
+    }
+
+    static Vec2 turn(Vec2 p, const Group& g) { return {g.cos * p.x + g.sin * p.y, g.cos * p.y - g.sin * p.x}; }
+
+    void build() {
+        const size_t n = m_segments.size();
+        std::vector<int> cls(n);
+        for (size_t i = 0; i < n; ++i) cls[i] = std::ilogb(m_length[i]);
+        std::vector<int32_t> order(n);
+        for (size_t i = 0; i < n; ++i) order[i] = static_cast<int32_t>(i);
+        std::sort(order.begin(), order.end(), [&](int32_t a, int32_t b) {
+            return cls[a] != cls[b] ? cls[a] < cls[b] : m_angle[a] < m_angle[b];
+        });
+        m_members = order;
+        m_turned.resize(n);
+        m_boxes.resize(n);
+
+        for (size_t first = 0; first < n;) {
+            const int c = cls[static_cast<size_t>(order[first])];
+            size_t last = first;
+            while (last < n && cls[static_cast<size_t>(order[last])] == c) ++last;
+            const double shortest = std::ldexp(1.0, c);
+            Class k;
+            k.window = window(shortest);
+            k.begin = m_groups.size();
+            // Group width: members (shorter than 2 shortest) then stay within
+            // 4 T of their group's axis. A class whose window takes in every
+            // direction is one group, unturned: its segments are a few T long.
+            const double width = k.window >= any_direction ? std::numbers::pi : 4 * m_T / shortest;
+            for (size_t g = first; g < last;) {
+                Group group;
+                group.begin = g;
+                group.angle_lo = m_angle[static_cast<size_t>(order[g])];
+                size_t e = g;
+                while (e < last && m_angle[static_cast<size_t>(order[e])] - group.angle_lo <= width) ++e;
+                group.end = e;
+                group.angle_hi = m_angle[static_cast<size_t>(order[e - 1])];
+                if (width < std::numbers::pi) {
+                    const double axis = 0.5 * (group.angle_lo + group.angle_hi);
+                    group.cos = std::cos(axis);
+                    group.sin = std::sin(axis);
+                }
+                for (size_t m = g; m < e; ++m) {
+                    const Segment& s = m_segments[static_cast<size_t>(order[m])];
+                    m_turned[m] = {turn(s.a, group), turn(s.b, group)};
+                    m_boxes[m] = Box{};
+                    m_boxes[m].add(m_turned[m]);
+                }
+                if (e - g > linear_group) {
+                    m_trees.emplace_back(
+                        std::vector<Segment>(m_turned.begin() + static_cast<std::ptrdiff_t>(g),
+                                             m_turned.begin() + static_cast<std::ptrdiff_t>(e)),
+                        2);
+                    group.tree = static_cast<int>(m_trees.size() - 1);
+                }
+                m_groups.push_back(group);
+                g = e;
+            }
+            k.end = m_groups.size();
+            m_classes.push_back(k);
+            first = last;
+        }
+    }
+
+    /// Calls on_candidate(t) for every segment t that the bounds of step 1
+    /// do not rule out as lying on s or s on it (s itself among them).
+    template <class OnCandidate>
+    void visit_candidates(size_t s, std::vector<int32_t>& stack, OnCandidate&& on_candidate) const {
+        const double angle = m_angle[s], own = window(m_length[s]);
+        for (const Class& k : m_classes) {
+            const double w = std::max(own, k.window);
+            const auto range = [&](double lo, double hi) { visit_range(k, lo, hi, s, stack, on_candidate); };
+            if (w >= any_direction) {
+                range(-1.0, 4.0);
+            } else if (angle - w < 0) {  // the window wraps around 0 = pi
+                range(angle - w + std::numbers::pi, 4.0);
+                range(-1.0, angle + w);
+            } else if (angle + w >= std::numbers::pi) {
+                range(angle - w, 4.0);
+                range(-1.0, angle + w - std::numbers::pi);
+            } else {
+                range(angle - w, angle + w);
+            }
+        }
+    }
+
+    /// The groups of class k with a member direction in [lo, hi].
+    template <class OnCandidate>
+    void visit_range(const Class& k, double lo, double hi, size_t s, std::vector<int32_t>& stack,
+                     OnCandidate&& on_candidate) const {
+        const auto begin = m_groups.begin() + static_cast<std::ptrdiff_t>(k.begin);
+        const auto end = m_groups.begin() + static_cast<std::ptrdiff_t>(k.end);
+        // Groups partition the class's sorted directions, so angle_hi grows too.
+        auto it = std::partition_point(begin, end, [lo](const Group& g) { return g.angle_hi < lo; });
+        for (; it != end && it->angle_lo <= hi; ++it) visit_group(*it, s, stack, on_candidate);
+    }
+
+    template <class OnCandidate>
+    void visit_group(const Group& group, size_t s, std::vector<int32_t>& stack, OnCandidate&& on_candidate) const {
+        const Segment& g = m_segments[s];
+        Box box;
+        box.add(turn(g.a, group));
+        box.add(turn(g.b, group));
+        const double pad = 16 * m_T;
+        box.lo -= Vec2{pad, pad};
+        box.hi += Vec2{pad, pad};
+        const auto meets = [&box](const Box& b) {
+            return !(b.hi.x < box.lo.x || b.lo.x > box.hi.x || b.hi.y < box.lo.y || b.lo.y > box.hi.y);
+        };
+        if (group.tree < 0) {
+            for (size_t m = group.begin; m < group.end; ++m)
+                if (meets(m_boxes[m])) on_candidate(static_cast<size_t>(m_members[m]));
+            return;
+        }
+        m_trees[static_cast<size_t>(group.tree)].query(
+            meets,
+            [&](int k, const Segment&) {
+                const size_t m = group.begin + static_cast<size_t>(k);
+                if (meets(m_boxes[m])) on_candidate(static_cast<size_t>(m_members[m]));
+            },
+            stack);
+    }
+
+    /// Groups up to this size are scanned rather than given a hierarchy.
+    static constexpr size_t linear_group = 8;
+
+    const std::vector<Segment>& m_segments;
+    std::vector<double> m_length, m_angle;
+    double m_T = 0;
+    std::vector<int32_t> m_members;   // segment numbers by class, then direction
+    std::vector<Segment> m_turned;    // m_members' segments in their group's frame
+    std::vector<Box> m_boxes;         // and their boxes there
+    std::vector<Group> m_groups;      // by class, then direction
+    std::vector<Class> m_classes;     // by length
+    std::vector<Hierarchy> m_trees;
+};
+
+// ---- simple polygons ---------------------------------------------------------
+
+/// Thrown inside the sweep below when a test cannot be decided with margin
+/// (or finds the polygon not simple): the sweep gives up, and the all-pairs
+/// test decides.
+struct SweepUndecided {};
+
+/// Sign of orient(a, b, c) when rounding cannot have changed it, else 0.
+/// orient's error is below about 3.1 eps |b - a| |c - a| (the differences
+/// round, then cross rounds once); the margin here is five times that.
+int clear_sign(Vec2 a, Vec2 b, Vec2 c) {
+    const Vec2 u = b - a, v = c - a;
+    const double o = cross(u, v);
+    const double bound = 16 * std::numeric_limits<double>::epsilon() * (std::abs(u.x) + std::abs(u.y)) *
+                         (std::abs(v.x) + std::abs(v.y));
+    return o > bound ? 1 : o < -bound ? -1 : 0;
+}
+
+/// Shamos-Hoey sweep over the edges of a closed polygon (points q): edges
+/// enter the status (ordered bottom to top at the sweep line) at their
+/// lexicographically smaller end and leave at the other; each edge is tested
+/// against its neighbours whenever it gets new ones. Non-neighbouring edges
+/// that cross are neighbours in the status just before the leftmost crossing,
+/// so that one is found; every order and crossing decision is a clear_sign,
+/// so with exact arithmetic the same decisions would be made. Besides, each
+/// vertex must lie at least `clearance` from the lines of the edges just
+/// above and below it in the status. Throws SweepUndecided otherwise.
+/// O(n log n).
+class PolygonSweep {
+public:
+    PolygonSweep(const std::vector<Vec2>& q, double clearance)
+        : m_q(q), m_n(q.size()), m_clearance(clearance), m_status(Order{this}) {}
+
+    void run() {
+        std::vector<size_t> events(m_n);
+        for (size_t k = 0; k < m_n; ++k) events[k] = k;
+        std::sort(events.begin(), events.end(), [this](size_t a, size_t b) { return before(m_q[a], m_q[b]); });
+        m_where.assign(m_n, m_status.end());
+        for (const size_t k : events) {
+            const Vec2 v = m_q[k];
+            const size_t incident[2] = {(k + m_n - 1) % m_n, k};
+            // Edges ending at v leave; their neighbours meet.
+            for (const size_t e : incident) {
+                if (!before(other_end(e, k), v)) continue;
+                auto it = m_where[e];
+                auto next = std::next(it);
+                const bool has_below = it != m_status.begin(), has_above = next != m_status.end();
+                const size_t below = has_below ? *std::prev(it) : 0, above = has_above ? *next : 0;
+                m_status.erase(it);
+                if (has_below && has_above) test(below, above);
+            }
+            // v clear of the edges just below and above it (none is incident).
+            m_point = v;
+            const auto it = m_status.lower_bound(PointKey{});
+            if (it != m_status.end()) require_clearance(*it, v);
+            if (it != m_status.begin()) require_clearance(*std::prev(it), v);
+            // Edges starting at v enter; each meets its new neighbours.
+            for (const size_t e : incident) {
+                if (before(other_end(e, k), v)) continue;
+                m_inserting = e;
+                const auto placed = m_status.insert(e).first;
+                m_inserting = none;
+                m_where[e] = placed;
+                if (placed != m_status.begin()) test(*std::prev(placed), e);
+                if (std::next(placed) != m_status.end()) test(e, *std::next(placed));
+            }
+        }
+    }
+
+private:
+    static constexpr size_t none = std::numeric_limits<size_t>::max();
+    struct PointKey {};  // stands for m_point in status searches
+
+    /// The sweep order on points: by x, then y.
+    static bool before(Vec2 a, Vec2 b) { return a.x < b.x || (a.x == b.x && a.y < b.y); }
+
+    Vec2 start(size_t e) const { return m_q[e]; }
+    Vec2 end(size_t e) const { return m_q[(e + 1) % m_n]; }
+    Vec2 other_end(size_t e, size_t vertex) const { return e == vertex ? end(e) : start(e); }
+    Vec2 lo(size_t e) const { return before(start(e), end(e)) ? start(e) : end(e); }
+    Vec2 hi(size_t e) const { return before(start(e), end(e)) ? end(e) : start(e); }
+
+    /// +1 when edge x (entering at m_point) goes above edge y (in the status), -1 below.
+    int side(size_t x, size_t y) const {
+        // Two edges entering at one vertex: the one whose far end is above the other.
+        const int s = lo(y) == lo(x) ? clear_sign(lo(y), hi(y), hi(x)) : clear_sign(lo(y), hi(y), lo(x));
+        if (s == 0) throw SweepUndecided{};  // touching, folded, or too close to tell
+        return s;
+    }
+
+    struct Order {
+        using is_transparent = void;
+        const PolygonSweep* sweep;
+        bool operator()(size_t a, size_t b) const {
+            if (a == sweep->m_inserting && b != a) return sweep->side(a, b) < 0;
+            if (b == sweep->m_inserting && a != b) return sweep->side(b, a) > 0;
+            throw SweepUndecided{};  // only the entering edge is ever compared
+        }
+        // Edge e below the point / the point below edge e.
+        bool operator()(size_t e, PointKey) const { return sweep->point_side(e) > 0; }
+        bool operator()(PointKey, size_t e) const { return sweep->point_side(e) < 0; }
+    };
+
+    int point_side(size_t e) const {
+        const int s = clear_sign(lo(e), hi(e), m_point);
+        if (s == 0) throw SweepUndecided{};
+        return s;
+    }
+
+    void require_clearance(size_t e, Vec2 v) const {
+        const Vec2 a = lo(e), b = hi(e);
+        const double margin = m_clearance * norm(b - a) * (1 + 1e-6);
+        const Vec2 u = b - a, w = v - a;
+        const double bound = 16 * std::numeric_limits<double>::epsilon() * (std::abs(u.x) + std::abs(u.y)) *
+                             (std::abs(w.x) + std::abs(w.y));
+        if (!(std::abs(cross(u, w)) > margin + bound)) throw SweepUndecided{};
+    }
+
+    /// Edges i and j have just become neighbours in the status.
+    void test(size_t i, size_t j) const {
+        if ((i + 1) % m_n == j || (j + 1) % m_n == i) {
+            // Polygon neighbours u -> v -> w share v; they must not fold back
+            // onto each other along one line: w clearly off the line u v, or
+            // clearly on the far side of v (a straight continuation).
+            const size_t first = (i + 1) % m_n == j ? i : j, second = first == i ? j : i;
+            const Vec2 u = start(first), v = end(first), w = end(second);
+            if (clear_sign(u, v, w) != 0) return;
+            const Vec2 a = u - v, b = w - v;
+            const double bound = 16 * std::numeric_limits<double>::epsilon() * (std::abs(a.x) + std::abs(a.y)) *
+                                 (std::abs(b.x) + std::abs(b.y));
+            if (!(dot(a, b) < -bound)) throw SweepUndecided{};
+            return;
+        }
+        // Disjoint when one edge is clearly on one side of the other's line
+        // (an end may be on that line, outside the edge: collinear pieces of
+        // one wall); crossing when each clearly straddles the other's line.
+        const int o1 = clear_sign(start(i), end(i), start(j)), o2 = clear_sign(start(i), end(i), end(j));
+        const int o3 = clear_sign(start(j), end(j), start(i)), o4 = clear_sign(start(j), end(j), end(i));
+        if ((o1 != 0 && o1 == o2) || (o3 != 0 && o3 == o4)) return;
+        throw SweepUndecided{};  // they cross, touch, or come too close to tell
+    }
+
+    const std::vector<Vec2>& m_q;
+    const size_t m_n;
+    const double m_clearance;
+    std::set<size_t, Order> m_status;
+    std::vector<std::set<size_t, Order>::iterator> m_where;  // each edge's place in the status
+    size_t m_inserting = none;
+    Vec2 m_point;
+};
+
+/// True when the closed polygon p certainly passes the all-pairs test of
+/// SceneReader::check_simple (no pair of edges it would find meeting, with
+/// its own rounding); false when that cannot be shown quickly, and the
+/// all-pairs test must decide. O(n log n).
+///
+/// That test works in floating point, so besides pairs that meet it may
+/// refuse pairs that come within rounding of meeting: roughly, a vertex
+/// within r = 9 eps x (largest |coordinate|) of the line of an edge it is
+/// not on, inside that edge's box, or two edges nearly on one line. Such a
+/// vertex lies within a few r of the edge itself, or of one of its ends.
+/// So the polygon is accepted here when, with R = 256 eps x largest
+/// |coordinate| (about 28 r):
+///  - no two vertices are within R of each other (a grid of cells of side
+///    R, sorted, each vertex against its 3 x 3 cells);
+///  - a PolygonSweep in x, and another with the polygon turned a quarter
+///    turn, finish: no crossing, no folding, and every vertex further than
+///    R from the lines of the edges just above and below it. An edge within
+///    a few r of a vertex, and spanning it in the sweep direction in which
+///    the edge is the flatter (slope at most 1), lies within 1.5 x that
+///    distance vertically of it; the edge just above or below the vertex is
+///    at least that near, so it would have been refused. (If it does not
+///    span the vertex, the vertex is within a few r of one of its ends.)
+/// Far below 1e-100 the sweep's products could underflow: no answer there.
+bool polygon_clearly_simple(const std::vector<Vec2>& p) {
+    double largest = 0;
+    for (const Vec2 q : p) largest = std::max({largest, std::abs(q.x), std::abs(q.y)});
+    if (!(largest >= 1e-100)) return false;
+    const double clearance = 256 * std::numeric_limits<double>::epsilon() * largest;
+
+    // Vertices apart: cell indices stay below 2^45 (|x| / clearance).
+    struct Cell {
+        std::int64_t x, y;
+        size_t vertex;
+        bool operator<(const Cell& o) const { return x != o.x ? x < o.x : y < o.y; }
+    };
+    std::vector<Cell> cells;
+    cells.reserve(p.size());
+    for (size_t k = 0; k < p.size(); ++k)
+        cells.push_back({static_cast<std::int64_t>(std::floor(p[k].x / clearance)),
+                         static_cast<std::int64_t>(std::floor(p[k].y / clearance)), k});
+    std::sort(cells.begin(), cells.end());
+    for (const Cell& c : cells)
+        for (std::int64_t dx = -1; dx <= 1; ++dx)
+            for (std::int64_t dy = -1; dy <= 1; ++dy) {
+                const auto [from, to] = std::equal_range(cells.begin(), cells.end(), Cell{c.x + dx, c.y + dy, 0});
+                for (auto it = from; it != to; ++it)
+                    if (it->vertex != c.vertex && !(distance(p[it->vertex], p[c.vertex]) > clearance)) return false;
+            }
+
+    std::vector<Vec2> turned(p.size());
+    for (size_t k = 0; k < p.size(); ++k) turned[k] = {p[k].y, -p[k].x};  // exact, keeps orientation
+    try {
+        PolygonSweep(p, clearance).run();
+        PolygonSweep(turned, clearance).run();
+    } catch (const SweepUndecided&) {
+        return false;
+    }
+    return true;
 }
 
 /// Which range a channel value must lie in.
@@ -768,10 +1244,15 @@ private:
     /// Refuses a polygon that crosses or touches itself: non-neighbouring
     /// edges must not meet at all, neighbouring edges only at their shared
     /// vertex (a fold back along the same line counts as touching).
-    /// Broad phase: edges sorted by their left end and swept in x; the
-    /// exact-ish orientation tests then decide. Worst case O(n^2) (many edges
-    /// spanning the whole x range), typically near O(n log n).
+    /// polygon_clearly_simple accepts in O(n log n) what this test would
+    /// accept with room to spare. Otherwise, the test itself: edges sorted
+    /// by their left end and swept in x as a broad phase, the orientation
+    /// tests deciding. That is O(n^2) at worst (many edges spanning the
+    /// whole x range), but only polygons that are refused, or that come
+    /// within about 1e-13 (relative) of touching themselves, get here; the
+    /// first pair it finds is the one named.
     void check_simple(const std::vector<Vec2>& p, const std::string& path, Side side) const {
+        if (polygon_clearly_simple(p)) return;
         const size_t n = p.size();
         struct Edge {
             Box box;
@@ -831,51 +1312,50 @@ private:
     // patch or a black unlit side twice), so row sums of F exceed 1 and a
     // stiff scene solves to negative radiosity (found by the fuzzer). Such
     // a scene is refused; segments meeting end to end, or crossing, are fine.
-    // Candidates come from the cluster hierarchy: O(N log N) for the check.
+    // OverlapFinder finds the first offending segment s in O(N log N); the
+    // one named as lying on it is then found as the all-pairs search over
+    // the cluster hierarchy that it replaces did (the first t > s in that
+    // hierarchy's order), so messages are unchanged. That search can only
+    // miss a pair lies_on accepts by a hair (it tests leaf boxes, padded
+    // by s's rounding alone); then the first such t is named.
     void check_no_overlaps(const Scene& scene) const {
         const std::vector<Segment> geometry = scene.segment_geometry();
         if (geometry.size() < 2) return;
+        const auto found = OverlapFinder(geometry).first();
+        if (!found) return;
+        const size_t s = found->first;
+        size_t t = found->second;
+
+        const Segment& g = geometry[s];
         const Hierarchy hierarchy(geometry, 2);
         std::vector<int32_t> stack;
-        // Points off a line by a few ulps of the coordinates are on it; a
-        // sliver 3 wide at 1e15 (24 ulps) is real geometry and is kept.
-        const double rounding = 4 * std::numeric_limits<double>::epsilon();
-        auto magnitude = [](const Segment& g) {
-            return std::max({std::abs(g.a.x), std::abs(g.a.y), std::abs(g.b.x), std::abs(g.b.y)});
-        };
-        for (size_t s = 0; s < geometry.size(); ++s) {
-            const Segment& g = geometry[s];
-            const double L = g.length();
-            Box box;
-            box.add(g);
-            const double pad = rounding * (magnitude(g) + L);
-            box.lo -= Vec2{pad, pad};
-            box.hi += Vec2{pad, pad};
-            hierarchy.query(
-                [&](const Box& b) {
-                    return !(b.hi.x < box.lo.x || b.lo.x > box.hi.x || b.hi.y < box.lo.y || b.lo.y > box.hi.y);
-                },
-                [&](int t, const Segment& h) {
-                    if (t <= static_cast<int>(s)) return;
-                    const double tol = rounding * (std::max(magnitude(g), magnitude(h)) + std::max(L, h.length()));
-                    // On g's line (distance within rounding) ...
-                    if (std::abs(orient(g.a, g.b, h.a)) > tol * L || std::abs(orient(g.a, g.b, h.b)) > tol * L) return;
-                    // ... and overlapping it over more than rounding.
-                    const Vec2 d = (g.b - g.a) / L;
-                    const double u0 = dot(h.a - g.a, d), u1 = dot(h.b - g.a, d);
-                    const double overlap = std::min(L, std::max(u0, u1)) - std::max(0.0, std::min(u0, u1));
-                    if (overlap <= tol) return;
-                    const SceneSegment& a = scene.segments[s];
-                    const SceneSegment& b = scene.segments[static_cast<size_t>(t)];
-                    fail(fmt::format("surfaces[{}].points[{}]", b.surface, b.index),
-                         fmt::format("segment {} of surface \"{}\" lies on segment {} of surface \"{}\" over a "
-                                     "length of {:g}: two surfaces in one place would each be seen twice; "
-                                     "remove the overlap (segments may meet end to end or cross)",
-                                     b.index, scene.surfaces[static_cast<size_t>(b.surface)].name, a.index,
-                                     scene.surfaces[static_cast<size_t>(a.surface)].name, overlap));
-                },
-                stack);
-        }
+        Box box;
+        box.add(g);
+        const double pad = overlap_rounding * (magnitude(g) + g.length());
+        box.lo -= Vec2{pad, pad};
+        box.hi += Vec2{pad, pad};
+        bool named = false;
+        hierarchy.query(
+            [&](const Box& b) {
+                return !named &&
+                       !(b.hi.x < box.lo.x || b.lo.x > box.hi.x || b.hi.y < box.lo.y || b.lo.y > box.hi.y);
+            },
+            [&](int k, const Segment& h) {
+                if (named || k <= static_cast<int>(s) || !lies_on(g, h)) return;
+                t = static_cast<size_t>(k);
+                named = true;
+            },
+            stack);
+
+        const double overlap = *lies_on(g, geometry[t]);
+        const SceneSegment& a = scene.segments[s];
+        const SceneSegment& b = scene.segments[t];
+        fail(fmt::format("surfaces[{}].points[{}]", b.surface, b.index),
+             fmt::format("segment {} of surface \"{}\" lies on segment {} of surface \"{}\" over a "
+                         "length of {:g}: two surfaces in one place would each be seen twice; "
+                         "remove the overlap (segments may meet end to end or cross)",
+                         b.index, scene.surfaces[static_cast<size_t>(b.surface)].name, a.index,
+                         scene.surfaces[static_cast<size_t>(a.surface)].name, overlap));
     }
 
     /// Appends the surface's segments and patches in SPEC numbering: segment

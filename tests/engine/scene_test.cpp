@@ -81,6 +81,22 @@ TEST_CASE("scene: a repeated key is refused where it repeats") {
                              R"({"name": "b", "material": "white", "points": [[0, 1], [1, 1]], "side": "left",
                                  "side": "right"})"),
                   "surfaces[1].side");
+    // Objects with many keys are tested with a hash set (beyond 8 keys):
+    // the repeat is still named where it repeats, however far apart.
+    std::string many;
+    for (int k = 0; k < 40; ++k) many += R"(, "extra)" + std::to_string(k) + R"(": )" + std::to_string(k);
+    CHECK_NOTHROW(parse_scene(R"({"flatrad": 1)" + many + R"(, "materials": {"white": {}}, "surfaces": [)" +
+                                  floor_surface + "]}",
+                              label));
+    CHECK_REFUSED(R"({"flatrad": 1)" + many + R"(, "extra3": 0, "materials": {}, "surfaces": []})", "extra3");
+    CHECK_REFUSED(R"({"flatrad": 1)" + many + R"(, "flatrad": 1, "materials": {}, "surfaces": []})", "flatrad");
+    std::string materials;
+    for (int k = 0; k < 30; ++k) materials += (k ? ", " : "") + std::string(R"("m)") + std::to_string(k) + R"(": {})";
+    CHECK_REFUSED(scene_json(floor_surface, "{" + materials + R"(, "m12": {"reflectance": 0.5}})"), "materials.m12");
+    CHECK_REFUSED(scene_json(floor_surface + ", " + surface(R"("points": [[0, 1], [1, 1]])" + many + ", " +
+                                                            R"("extra39": 1)",
+                                                            "b")),
+                  "surfaces[1].extra39");
 }
 
 TEST_CASE("scene: missing required keys") {
