@@ -1143,6 +1143,7 @@ Solution HierarchicalSolver::run() {
     sol.stats.elements = m_element_leaves;
     sol.stats.links = static_cast<long>(m_links.size());
     sol.stats.patches_left_out = m_left_out;
+    sol.stats.cluster_links = m_cluster_links;
     sol.stats.iterations = m_iterations;
     sol.stats.residual = m_residual;
     sol.stats.threads = m_threads;

@@ -31,6 +31,7 @@ struct SolveStats {
     long links = 0;          ///< non-zero element-pair form factors
     long iterations = 0;     ///< 0 for a direct solve
     long patches_left_out = 0;  ///< hierarchical: patches no emitter can reach (not solved; B = E = 0)
+    long cluster_links = 0;     ///< hierarchical: links with a cluster at either end (part of `links`)
     double residual = 0;     ///< max over channels of ||(I - rho F) B - E||_inf / ||E||_inf
     int threads = 1;
     VisibilityStats visibility;
