@@ -31,6 +31,10 @@ namespace {
 
 constexpr int K = directional_bins;
 
+// Below this many links (each a visibility query, up to ~1 ms) a batch runs
+// on one thread; decisions and gathers (~1 us each) need 16x more.
+constexpr long parallel_min_work = 64;
+
 // GMRES stops at ||E - (I - rho G) B|| <= 1e-12 ||E||: the operator is
 // applied in double with sums of at most a few thousand terms per node, so
 // 1e-12 is reachable and keeps B to ~1e-9 relative even where
@@ -503,7 +507,9 @@ void HierarchicalSolver::compute_links(std::vector<Link>& links) {
     const auto t0 = Clock::now();
     const long n = static_cast<long>(links.size());
     std::vector<char> keep(links.size(), 1);
-#pragma omp parallel num_threads(m_threads)
+    // Small batches run on one thread: waking the team costs more than
+    // they do (and much more on a loaded machine).
+#pragma omp parallel num_threads(m_threads) if (n > parallel_min_work)
     {
         ExactWorkspace ws;
         VisibilityStats local;
@@ -746,7 +752,7 @@ bool HierarchicalSolver::refine(const std::vector<double>& leaf_bmax) {
         // 1. Decide, in parallel.
         decision.assign(work.size(), 0);
         const long nw = static_cast<long>(work.size());
-#pragma omp parallel for num_threads(m_threads) schedule(dynamic, 64)
+#pragma omp parallel for num_threads(m_threads) schedule(dynamic, 64) if (nw > 16 * parallel_min_work)
         for (long k = 0; k < nw; ++k) {
             const Link& l = m_links[static_cast<size_t>(work[static_cast<size_t>(k)])];
             const Node& r = m_nodes[static_cast<size_t>(l.r)];
@@ -880,7 +886,7 @@ void HierarchicalSolver::apply_G(const Eigen::VectorXd& x, Eigen::VectorXd& out,
     m_J.assign(static_cast<size_t>(m_tables_count) * K, 0.0);
     // Gather, in parallel over receivers.
     const long R = static_cast<long>(m_receivers.size());
-#pragma omp parallel for num_threads(m_threads) schedule(dynamic, 256)
+#pragma omp parallel for num_threads(m_threads) schedule(dynamic, 256) if (R > 16 * parallel_min_work)
     for (long q = 0; q < R; ++q) {
         const int r = m_receivers[static_cast<size_t>(q)];
         const Node& nr = m_nodes[static_cast<size_t>(r)];
