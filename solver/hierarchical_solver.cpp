@@ -950,11 +950,12 @@ void HierarchicalSolver::apply_G(const Eigen::VectorXd& x, Eigen::VectorXd& out,
 void HierarchicalSolver::solve() {
     const auto t0 = Clock::now();
     collect_leaves();
-    reach();
     sort_links();
     const Eigen::Index n = static_cast<Eigen::Index>(m_element_leaves);
     // Row sums: a leaf of a patch whose light cannot leave the scene and
-    // that sees no sink must gather exactly 1 for B = 1 everywhere.
+    // that sees no sink must gather exactly 1 for B = 1 everywhere. Probed
+    // with every link, before reach() drops those from dark senders (they
+    // are part of the leaf's geometry, and carry 0 in the solve).
     m_deficit.assign(static_cast<size_t>(n), 0.0);
     m_anc_sum.assign(static_cast<size_t>(n), 0.0);
     m_own_sum.assign(static_cast<size_t>(n), 0.0);
@@ -969,6 +970,8 @@ void HierarchicalSolver::solve() {
             m_own_sum[static_cast<size_t>(i)] = m_Hn[static_cast<size_t>(node)];
         }
     }
+    reach();
+    sort_links();
     m_B.assign(static_cast<size_t>(m_C), std::vector<double>(m_nodes.size(), 0.0));
     m_H = m_B;
     GmresOptions go;
@@ -1118,7 +1121,7 @@ Solution HierarchicalSolver::run() {
     // leave the scene (not escape-free, engine/connectivity.h). What the
     // escape-free ones lose is the solver's own error and shows as balance;
     // in a scene with no escape-free patch, balance only checks the solve.
-    const std::vector<double> omega = m_links.empty() ? std::vector<double>(m_nodes.size(), 1.0) : landed_fraction();
+    const std::vector<double> omega = landed_fraction();  // 0 everywhere when there are no links
     for (int c = 0; c < m_C; ++c) {
         const auto& B = m_B[static_cast<size_t>(c)];
         const auto& H = m_H[static_cast<size_t>(c)];

@@ -26,6 +26,31 @@ std::vector<int> side_rooms(const Scene& scene, const Connectivity& conn) {
         }
     }
     double budget = 1e8;
+    // A loop is a wall between rooms only if nothing off it crosses or
+    // touches it (segments may cross: two crossing loops, or a plate
+    // through a wall, would let light pass between its sides' rooms).
+    {
+        std::vector<int> clean;
+        for (int k : order) {
+            const SceneLoop& L = conn.loops[static_cast<size_t>(k)];
+            budget -= static_cast<double>(S) * static_cast<double>(L.polygon.size());
+            if (budget < 0) break;  // too costly to prove: not used (unknown rooms are always safe)
+            bool ok = true;
+            for (size_t s = 0; s < S && ok; ++s) {
+                if (seg_loop[s] == k) continue;
+                const Segment& g = scene.segments[s].seg;
+                const bool near = std::max(g.a.x, g.b.x) >= L.box.lo.x && std::min(g.a.x, g.b.x) <= L.box.hi.x &&
+                                  std::max(g.a.y, g.b.y) >= L.box.lo.y && std::min(g.a.y, g.b.y) <= L.box.hi.y;
+                if (near && meets(g, L.polygon)) ok = false;
+            }
+            if (ok) clean.push_back(k);
+        }
+        for (int k : order)
+            if (std::find(clean.begin(), clean.end(), k) == clean.end())
+                for (int s : conn.loops[static_cast<size_t>(k)].segments) seg_loop[static_cast<size_t>(s)] = -1;
+        order = clean;
+        budget = 1e8;
+    }
     // Innermost usable loop strictly containing segment s (not one it is on).
     auto container = [&](size_t s) -> int {
         const Segment& g = scene.segments[s].seg;

@@ -8,7 +8,8 @@
 /// closed box would leak into the box beside it through their walls).
 ///
 /// A side's room is the innermost simple loop of known orientation
-/// (engine/connectivity.h) that holds its light:
+/// (engine/connectivity.h) that nothing else crosses or touches, holding its
+/// light:
 ///  - a side of a loop's own segment lit towards the loop's interior: that
 ///    loop;
 ///  - a side lit towards the exterior, or a segment on no loop: the

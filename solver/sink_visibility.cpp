@@ -32,15 +32,26 @@ std::vector<char> visible_sinks(const Scene& scene, const Connectivity& conn) {
             if (touches || wa != Where::Inside || wb != Where::Inside) all_inside = false;
             if (touches || wa != Where::Outside || wb != Where::Outside) none_inside = false;
         }
+        // L's own lit sides see its unlit ones on the same side of it: a
+        // lit interior side sees the interior sinks, a lit exterior side (of
+        // a non-convex loop) the exterior ones.
+        bool lit_interior = false, lit_exterior = false;
         for (size_t k = 0; k < L.segments.size(); ++k) {
-            const size_t s = static_cast<size_t>(L.segments[k]);
+            const SceneSegment& ss = scene.segments[static_cast<size_t>(L.segments[k])];
             // The interior is left of the traversal when counter-clockwise;
             // traversal runs a -> b when forward.
+            const bool interior_left = (L.orientation > 0) == static_cast<bool>(L.forward[k]);
+            lit_interior = lit_interior || (interior_left ? ss.lit_left : ss.lit_right);
+            lit_exterior = lit_exterior || (interior_left ? ss.lit_right : ss.lit_left);
+        }
+        for (size_t k = 0; k < L.segments.size(); ++k) {
+            const size_t s = static_cast<size_t>(L.segments[k]);
             const bool interior_left = (L.orientation > 0) == static_cast<bool>(L.forward[k]);
             for (int side = 0; side < 2; ++side) {
                 if (!visible[2 * s + static_cast<size_t>(side)]) continue;
                 const bool faces_interior = (side == 0) == interior_left;
-                if (faces_interior ? none_inside : all_inside) visible[2 * s + static_cast<size_t>(side)] = 0;
+                if (faces_interior ? (none_inside && !lit_interior) : (all_inside && !lit_exterior))
+                    visible[2 * s + static_cast<size_t>(side)] = 0;
             }
         }
     }

@@ -10,10 +10,12 @@
 ///
 /// Rule (sufficient): the segment is on a simple loop L of known orientation
 /// (engine/connectivity.h) and
-///  - the unlit side faces L's exterior, and every segment not on L lies
-///    strictly inside L (both endpoints inside, no contact with L); or
-///  - the unlit side faces L's interior, and no segment not on L has an
-///    endpoint inside L or touches L.
+///  - the unlit side faces L's exterior, every segment not on L lies
+///    strictly inside L (both endpoints inside, no contact with L), and no
+///    side of L facing its exterior is lit; or
+///  - the unlit side faces L's interior, no segment not on L has an
+///    endpoint inside L or touches L, and no side of L facing its interior
+///    is lit.
 /// Point-in-polygon by crossing number; a point within rounding of L's
 /// boundary counts as touching (then the sink is kept: not proven).
 /// Cost: O(segments x |L|) per loop with unlit sides, skipped (sinks kept)

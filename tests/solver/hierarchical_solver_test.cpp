@@ -172,3 +172,38 @@ TEST_CASE("hierarchical solver: pays for what the scene uses (DESIGN.md §4)") {
                                       "blocked.json");
     CHECK(solve_hierarchical(blocked).stats.visibility.queries > 0);
 }
+
+TEST_CASE("hierarchical solver: review regressions (lit sides of a loop seeing its sinks, crossing loops, no links)") {
+    // A square loop whose first two walls are lit inside and last two only
+    // outside: the inside sinks are seen by the lit walls, so they must stay
+    // (they were dropped, and the row sums forced to 1 gave B = 2 for 1.18).
+    const Scene mixed = parse_scene(R"({"flatrad":1,"materials":{"lamp":{"reflectance":0.5,"emission":1.0},"w":{"reflectance":0.5}},
+      "surfaces":[{"name":"a","material":"lamp","side":"left","points":[[0,0],[1,0],[1,1]]},
+                  {"name":"b","material":"w","side":"right","points":[[1,1],[0,1],[0,0]]}]})",
+                                    "mixed.json");
+    // Crossing closed loops: the lamp in their overlap lights A's right
+    // wall inside B (it got no link when each loop was taken as a room).
+    const Scene cross = parse_scene(R"({"flatrad":1,"materials":{"lamp":{"reflectance":0.0,"emission":1.0},"w":{"reflectance":0.5}},
+      "surfaces":[{"name":"A","material":"w","closed":true,"side":"both","points":[[0,0],[2,0],[2,2],[0,2]]},
+                  {"name":"B","material":"w","closed":true,"side":"both","points":[[1,0.5],[4,0.5],[4,1.5],[1,1.5]]},
+                  {"name":"x","material":"lamp","side":"both","points":[[1.4,0.9],[1.4,1.1]]}]})",
+                                    "cross.json");
+    // Both within the default eps's ~1% (README) with a 3x margin.
+    constexpr double patch_tol = 3e-2;
+    for (const Scene* s : {&mixed, &cross}) {
+        CAPTURE(s->file);
+        const Solution h = solve_hierarchical(*s);
+        const Solution e = solve_exact(*s, {8, 0});
+        double scale = 0;
+        for (const PatchResult& p : e.patches) scale = std::max(scale, p.radiosity[0]);
+        for (size_t p = 0; p < s->patches.size(); ++p)
+            CHECK(std::abs(h.patches[p].radiosity[0] - e.patches[p].radiosity[0]) <= patch_tol * scale);
+    }
+    // A lone lamp: no link at all, so everything it sends escapes.
+    const Scene one = parse_scene(R"({"flatrad":1,"materials":{"lamp":{"reflectance":0.0,"emission":1.0}},
+      "surfaces":[{"name":"l","material":"lamp","side":"left","points":[[0,0],[1,0]]}]})",
+                                  "one.json");
+    const Solution h = solve_hierarchical(one);
+    CHECK(h.totals.escaped[0] == doctest::Approx(1.0));
+    CHECK(h.totals.balance[0] <= 1e-12);
+}
