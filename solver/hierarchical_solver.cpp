@@ -7,6 +7,9 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <mutex>
+#include <shared_mutex>
+#include <unordered_map>
 #include <fmt/format.h>
 
 #include "engine/compensated_sum.h"
@@ -179,6 +182,10 @@ private:
     Hierarchy m_hierarchy;
     ClusterTables m_tables;
     MultiscaleVisibility m_vis;
+    // Transmittance between two hierarchy nodes, per unordered pair
+    // (symmetric: the lines joining the two cross-sections).
+    mutable std::unordered_map<uint64_t, std::pair<double, double>> m_tau_cache;
+    mutable std::shared_mutex m_tau_mutex;
 
     std::vector<Node> m_nodes;
     int m_root = -1;
@@ -490,9 +497,27 @@ bool HierarchicalSolver::make_link(int r, int s, Link& l, ExactWorkspace& ws, Vi
     }
     double tau = 1, terr = 0;
     if (!m_unblockable) {
-        const TransmittanceResult t = m_vis.transmittance(nr.hnode, ns.hnode, m_vis_eps, GammaRule::Bound, ws, st);
-        tau = t.tau;
-        terr = t.error_bound;
+        // The same two hierarchy nodes come back many times (an element's
+        // halves keep their segment's node): one query per pair.
+        const uint64_t key = (static_cast<uint64_t>(std::min(nr.hnode, ns.hnode)) << 32) |
+                             static_cast<uint32_t>(std::max(nr.hnode, ns.hnode));
+        bool cached = false;
+        {
+            std::shared_lock lock(m_tau_mutex);
+            const auto it = m_tau_cache.find(key);
+            if (it != m_tau_cache.end()) {
+                tau = it->second.first;
+                terr = it->second.second;
+                cached = true;
+            }
+        }
+        if (!cached) {
+            const TransmittanceResult t = m_vis.transmittance(nr.hnode, ns.hnode, m_vis_eps, GammaRule::Bound, ws, st);
+            tau = t.tau;
+            terr = t.error_bound;
+            std::unique_lock lock(m_tau_mutex);
+            m_tau_cache.emplace(key, std::make_pair(tau, terr));
+        }
     } else {
         ++st.unoccluded;
     }
