@@ -29,9 +29,11 @@ double mean(const std::vector<double>& v) {
 void print_summary(std::ostream& os, const Scene& scene, const Solution& solution,
                    const std::string& written_to, int brightest) {
     const SolveStats& s = solution.stats;
-    os << fmt::format("flatrad: \"{}\" solved by {} (subdivide {}): {} patches, {} elements, {} links\n",
-                      scene.name, solution.method, solution.subdivide, scene.patches.size(),
-                      s.elements, s.links);
+    const std::string settings = solution.method == "hierarchical"
+                                     ? fmt::format("eps {:g}, vis-eps {:g}", solution.eps, solution.vis_eps)
+                                     : fmt::format("subdivide {}", solution.subdivide);
+    os << fmt::format("flatrad: \"{}\" solved by {} ({}): {} patches, {} elements, {} links\n", scene.name,
+                      solution.method, settings, scene.patches.size(), s.elements, s.links);
     os << fmt::format("  time {:.4g} s (form factors {:.4g} s, linear solve {:.4g} s, {} thread{})\n",
                       s.time_s, s.form_factor_time_s, s.linear_solve_time_s, s.threads,
                       s.threads == 1 ? "" : "s");
