@@ -172,6 +172,7 @@ private:
     void solve();
     std::vector<double> leaf_guess() const;
     std::vector<double> landed_fraction() const;
+    std::vector<double> push_down(std::vector<double>& tables, const std::vector<double>& own, double lobe_scale) const;
 
     const Scene& m_scene;
     HierarchicalOptions m_opt;
@@ -904,6 +905,40 @@ void HierarchicalSolver::reach() {
                   m_links.end());
 }
 
+// Top-down push, shared by the operator and its adjoint (landed_fraction):
+// cluster tables add their parent's (in place; parents come first), each
+// side reads its leaf cluster's parent table through its cosine lobe
+// (times lobe_scale), each element below gets its parent's own value plus
+// what reached the parent. Returns, per node, what reached it from above.
+std::vector<double> HierarchicalSolver::push_down(std::vector<double>& tables, const std::vector<double>& own,
+                                                  double lobe_scale) const {
+    const size_t N = m_nodes.size();
+    std::vector<double> above(N, 0.0);
+    for (size_t k = 0; k < N; ++k) {
+        const Node& n = m_nodes[k];
+        if (n.parent < 0) continue;
+        const Node& p = m_nodes[static_cast<size_t>(n.parent)];
+        if (n.cluster()) {
+            if (n.table >= 0 && p.table >= 0) {
+                double* dst = &tables[static_cast<size_t>(n.table) * K];
+                const double* src = &tables[static_cast<size_t>(p.table) * K];
+                for (int b = 0; b < K; ++b) dst[b] += src[b];
+            }
+            continue;
+        }
+        if (p.cluster()) {
+            // p is a leaf cluster: no link ends there, its table is its parent's.
+            if (p.parent >= 0 && m_nodes[static_cast<size_t>(p.parent)].table >= 0)
+                above[k] = lobe_scale * read_cosine_lobe(
+                                            &tables[static_cast<size_t>(m_nodes[static_cast<size_t>(p.parent)].table) * K],
+                                            n.normal);
+        } else {
+            above[k] = own[static_cast<size_t>(n.parent)] + above[static_cast<size_t>(n.parent)];
+        }
+    }
+    return above;
+}
+
 // G(x): pull the leaf radiosities x up (means and exitance tables), gather
 // along the links, push irradiance down to the leaves. With `correct`, a
 // closed leaf adds its row-sum deficit times its ancestors' mean arrival.
@@ -938,29 +973,7 @@ void HierarchicalSolver::apply_G(const Eigen::VectorXd& x, Eigen::VectorXd& out,
         if (!J) m_Hn[static_cast<size_t>(r)] = h;
     }
     // Push: tables down the clusters, then onto sides, then down elements.
-    m_Ha.assign(N, 0.0);  // what arrived at ancestors (row-sum correction)
-    for (size_t k = 0; k < N; ++k) {
-        const Node& n = m_nodes[k];
-        if (n.parent < 0) continue;
-        const Node& p = m_nodes[static_cast<size_t>(n.parent)];
-        if (n.cluster()) {
-            if (n.table >= 0 && p.table >= 0) {
-                double* dst = &m_J[static_cast<size_t>(n.table) * K];
-                const double* src = &m_J[static_cast<size_t>(p.table) * K];
-                for (int b = 0; b < K; ++b) dst[b] += src[b];
-            }
-            continue;
-        }
-        double from_above = 0;
-        if (p.cluster()) {
-            // p is a leaf cluster: its table is its parent's (no links end there).
-            const Node& pp = m_nodes[static_cast<size_t>(p.parent >= 0 ? p.parent : n.parent)];
-            if (p.parent >= 0 && pp.table >= 0) from_above = read_cosine_lobe(&m_J[static_cast<size_t>(pp.table) * K], n.normal);
-        } else {
-            from_above = m_Hn[static_cast<size_t>(n.parent)] + m_Ha[static_cast<size_t>(n.parent)];
-        }
-        m_Ha[k] = from_above;
-    }
+    m_Ha = push_down(m_J, m_Hn, 1.0);  // what arrived at ancestors (row-sum correction)
     out.resize(static_cast<Eigen::Index>(m_element_leaves));
     for (size_t i = 0; i < static_cast<size_t>(m_element_leaves); ++i) {
         const size_t k = static_cast<size_t>(m_leaves[i]);
@@ -1060,28 +1073,9 @@ std::vector<double> HierarchicalSolver::landed_fraction() const {
             own[static_cast<size_t>(l.s)] += d / s.length;
         }
     }
+    const std::vector<double> above = push_down(lam, own, 0.5);
     std::vector<double> omega(N, 0.0);
-    for (size_t k = 0; k < N; ++k) {
-        const Node& n = m_nodes[k];
-        if (n.parent < 0) continue;
-        const Node& p = m_nodes[static_cast<size_t>(n.parent)];
-        if (n.cluster()) {
-            if (n.table >= 0 && p.table >= 0) {
-                double* dst = &lam[static_cast<size_t>(n.table) * K];
-                const double* src = &lam[static_cast<size_t>(p.table) * K];
-                for (int b = 0; b < K; ++b) dst[b] += src[b];
-            }
-            continue;
-        }
-        double from_above = 0;
-        if (p.cluster()) {
-            if (p.parent >= 0 && m_nodes[static_cast<size_t>(p.parent)].table >= 0)
-                from_above = 0.5 * read_cosine_lobe(&lam[static_cast<size_t>(m_nodes[static_cast<size_t>(p.parent)].table) * K], n.normal);
-        } else {
-            from_above = omega[static_cast<size_t>(n.parent)];
-        }
-        omega[k] = from_above + own[k];
-    }
+    for (size_t k = 0; k < N; ++k) omega[k] = above[k] + own[k];
     return omega;
 }
 
