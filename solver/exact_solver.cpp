@@ -182,15 +182,7 @@ Solution solve_exact(const Scene& scene, const ExactSolverOptions& options) {
             row.add(-to_sinks[static_cast<size_t>(a)]);
             escaped.add(e.length * B(a, c) * row.value());
         }
-        const double em = emitted.value(), ab = absorbed.value();
-        // Escaped power in a closed scene is 1 - (a sum that is 1 up to
-        // rounding): report rounding-level values as 0, not as tiny negatives.
-        double es = escaped.value();
-        if (std::abs(es) <= 1e-12 * std::max(em, ab)) es = 0;
-        sol.totals.emitted.push_back(em);
-        sol.totals.absorbed.push_back(ab);
-        sol.totals.escaped.push_back(es);
-        sol.totals.balance.push_back(em > 0 ? std::abs(em - ab - es) / em : 0.0);
+        sol.totals.add_channel(emitted.value(), absorbed.value(), escaped.value());
     }
 
     sol.stats.form_factor_time_s = ff_time;

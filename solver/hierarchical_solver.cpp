@@ -1162,13 +1162,7 @@ Solution HierarchicalSolver::run() {
                 absorbed.add(L * H[k]);
             }
         }
-        const double em = emitted.value(), ab = absorbed.value();
-        double es = escaped.value();
-        if (std::abs(es) <= 1e-12 * std::max(em, ab)) es = 0;
-        sol.totals.emitted.push_back(em);
-        sol.totals.absorbed.push_back(ab);
-        sol.totals.escaped.push_back(es);
-        sol.totals.balance.push_back(em > 0 ? std::abs(em - ab - es) / em : 0.0);
+        sol.totals.add_channel(emitted.value(), absorbed.value(), escaped.value());
     }
 
     sol.stats.form_factor_time_s = m_ff_time;

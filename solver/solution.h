@@ -2,6 +2,8 @@
 /// What a solve returns: per-patch radiosity (SPEC numbering), per-element
 /// values, energy totals and what the run did. apps/ writes it as the result
 /// file of SPEC.md.
+#include <algorithm>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -21,6 +23,17 @@ struct PatchResult {
 
 struct Totals {
     std::vector<double> emitted, absorbed, escaped, balance;  ///< per channel (SPEC)
+
+    /// Appends one channel: escaped within 1e-12 of the larger of emitted and
+    /// absorbed is rounding (1 minus a sum that is 1) and reported as 0;
+    /// balance = |emitted - absorbed - escaped| / emitted (0 when nothing emits).
+    void add_channel(double em, double ab, double es) {
+        if (std::abs(es) <= 1e-12 * std::max(em, ab)) es = 0;
+        emitted.push_back(em);
+        absorbed.push_back(ab);
+        escaped.push_back(es);
+        balance.push_back(em > 0 ? std::abs(em - ab - es) / em : 0.0);
+    }
 };
 
 struct SolveStats {
