@@ -31,16 +31,20 @@ std::vector<Vec2> convex_hull(std::vector<Vec2> p) {
 
 }  // namespace
 
-bool no_segment_can_block(const Scene& scene) {
-    if (scene.segments.size() <= 2) return true;  // two segments: nothing else to block them
+std::vector<char> segments_on_hull(const std::vector<Segment>& segments, double extent) {
+    std::vector<char> on(segments.size(), 0);
+    if (segments.size() <= 2) {  // two segments: nothing else to block them
+        on.assign(segments.size(), 1);
+        return on;
+    }
     std::vector<Vec2> pts;
-    pts.reserve(2 * scene.segments.size());
-    for (const SceneSegment& s : scene.segments) {
-        pts.push_back(s.seg.a);
-        pts.push_back(s.seg.b);
+    pts.reserve(2 * segments.size());
+    for (const Segment& s : segments) {
+        pts.push_back(s.a);
+        pts.push_back(s.b);
     }
     const std::vector<Vec2> hull = convex_hull(pts);
-    if (hull.size() < 3) return false;  // all collinear: collinear segments face nothing anyway, but say "unsure"
+    if (hull.size() < 3) return on;  // all collinear: collinear segments face nothing anyway, but say "unsure"
     // A segment is on the boundary when its line supports the hull: for its
     // unit normal n (either sign), max over the hull of n . v equals n . a.
     // The maximising vertex is found by binary search on the hull's outward
@@ -65,17 +69,27 @@ bool no_segment_can_block(const Scene& scene) {
         best = std::max({best, dot(n, hull[(j + 1) % H]), dot(n, hull[(j + H - 1) % H])});
         return best;
     };
-    const double extent = scene.extent();
-    for (const SceneSegment& s : scene.segments) {
-        const double L = s.seg.length();
-        if (!(L > 0)) return false;
-        const Vec2 n = rot90(s.seg.b - s.seg.a) / L;
-        const double tol = 1e-12 * extent;
-        const double h = dot(n, s.seg.a);
-        const bool supports = support(n) <= h + tol || support(-n) <= -h + tol;
-        if (!supports) return false;
+    const double tol = 1e-12 * extent;
+    for (size_t k = 0; k < segments.size(); ++k) {
+        const Segment& s = segments[k];
+        const double L = s.length();
+        if (!(L > 0)) continue;
+        const Vec2 n = rot90(s.b - s.a) / L;
+        const double h = dot(n, s.a);
+        on[k] = support(n) <= h + tol || support(-n) <= -h + tol;
     }
-    return true;
+    return on;
+}
+
+std::vector<char> possible_blockers(const Scene& scene) {
+    std::vector<char> on = segments_on_hull(scene.segment_geometry(), scene.extent());
+    for (char& c : on) c = !c;
+    return on;
+}
+
+bool no_segment_can_block(const Scene& scene) {
+    const std::vector<char> b = possible_blockers(scene);
+    return std::find(b.begin(), b.end(), 1) == b.end();
 }
 
 }  // namespace flatrad

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 #include "engine/error.h"
 
@@ -144,6 +145,24 @@ Hierarchy::Hierarchy(const std::vector<Segment>& segments, int leaf_size) : m_se
             todo.push_back({left});
         }
         m_nodes[static_cast<size_t>(k)] = nd;
+    }
+    for (ClusterNode& nd : m_nodes) nd.blockers = nd.count;
+}
+
+void Hierarchy::set_blockers(const std::vector<char>& can_block) {
+    if (can_block.size() != m_segments.size())
+        throw std::invalid_argument("Hierarchy::set_blockers: one flag per segment expected");
+    m_can_block = can_block;
+    // Children come after their parents: count bottom-up.
+    for (size_t k = m_nodes.size(); k-- > 0;) {
+        ClusterNode& nd = m_nodes[k];
+        if (nd.leaf()) {
+            nd.blockers = 0;
+            for (int32_t q = nd.first; q < nd.first + nd.count; ++q)
+                nd.blockers += can_block[static_cast<size_t>(m_order[static_cast<size_t>(q)])] ? 1 : 0;
+        } else {
+            nd.blockers = m_nodes[static_cast<size_t>(nd.child[0])].blockers + m_nodes[static_cast<size_t>(nd.child[1])].blockers;
+        }
     }
 }
 

@@ -26,6 +26,7 @@ struct ClusterNode {
     int32_t first = 0;       ///< the node's segments are order[first .. first+count)
     int32_t count = 0;
     int32_t depth = 0;
+    int32_t blockers = 0;    ///< how many of them can block (all, unless Hierarchy::set_blockers said otherwise)
     bool leaf() const { return child[0] < 0; }
 };
 
@@ -44,11 +45,32 @@ public:
     const std::vector<Segment>& segments() const { return m_segments; }
     int depth() const { return m_depth; }
 
+    /// Marks which segments can block light (`can_block[segment number]`,
+    /// e.g. engine/convex_scene.h's possible_blockers): the visibility
+    /// module skips the others, and nodes with no blocker below. Every
+    /// segment can block until this is called.
+    void set_blockers(const std::vector<char>& can_block);
+    bool can_block(int segment) const {
+        return m_can_block.empty() || m_can_block[static_cast<size_t>(segment)] != 0;
+    }
+
     /// Visits every segment whose node boxes pass `box_test(const Box&)`,
     /// calling `on_segment(int segment_number, const Segment&)`. Returns the
     /// number of nodes visited (for stats).
     template <class BoxTest, class OnSegment>
     long query(BoxTest&& box_test, OnSegment&& on_segment, std::vector<int32_t>& stack) const {
+        return walk<false>(box_test, on_segment, stack);
+    }
+    /// The same over the segments that can block (set_blockers), never
+    /// entering a node with none below.
+    template <class BoxTest, class OnSegment>
+    long query_blockers(BoxTest&& box_test, OnSegment&& on_segment, std::vector<int32_t>& stack) const {
+        return walk<true>(box_test, on_segment, stack);
+    }
+
+private:
+    template <bool only_blockers, class BoxTest, class OnSegment>
+    long walk(BoxTest& box_test, OnSegment& on_segment, std::vector<int32_t>& stack) const {
         long visited = 0;
         if (m_nodes.empty()) return 0;
         stack.clear();
@@ -56,11 +78,13 @@ public:
         while (!stack.empty()) {
             const ClusterNode& n = m_nodes[static_cast<size_t>(stack.back())];
             stack.pop_back();
+            if (only_blockers && n.blockers == 0) continue;
             ++visited;
             if (!box_test(n.box)) continue;
             if (n.leaf()) {
                 for (int32_t k = n.first; k < n.first + n.count; ++k) {
                     const int32_t s = m_order[static_cast<size_t>(k)];
+                    if (only_blockers && !can_block(s)) continue;
                     on_segment(s, m_segments[static_cast<size_t>(s)]);
                 }
             } else {
@@ -71,10 +95,10 @@ public:
         return visited;
     }
 
-private:
     std::vector<ClusterNode> m_nodes;
     std::vector<int32_t> m_order;
     std::vector<Segment> m_segments;
+    std::vector<char> m_can_block;  // per segment number; empty: all
     int m_depth = 0;
 };
 

@@ -6,10 +6,11 @@
 #include <chrono>
 #include <fmt/format.h>
 
+#include "engine/compensated_sum.h"
+#include "engine/convex_scene.h"
 #include "engine/error.h"
 #include "engine/hierarchy.h"
 #include "solver/closed_enclosure.h"
-#include "engine/compensated_sum.h"
 #include "visibility/exact_visibility.h"
 
 namespace flatrad {
@@ -71,7 +72,8 @@ Solution solve_exact(const Scene& scene, const ExactSolverOptions& options) {
     // 2. Form factors, both cores: F(a, b) for every element pair, and the
     //    fraction of each element's light that lands on unlit sides.
     const auto t_ff = Clock::now();
-    const Hierarchy hierarchy(scene.segment_geometry());
+    Hierarchy hierarchy(scene.segment_geometry());
+    hierarchy.set_blockers(possible_blockers(scene));  // hull walls block nothing (engine/convex_scene.h)
     const ExactVisibility visibility(hierarchy);
     Eigen::MatrixXd F = Eigen::MatrixXd::Zero(n, n);
     std::vector<double> to_sinks(static_cast<size_t>(n), 0.0);

@@ -125,7 +125,11 @@ public:
         m_threads = o.threads > 0 ? o.threads : omp_get_max_threads();
         m_vis_eps = o.vis_eps >= 0 ? o.vis_eps : o.eps / 10;
 
-        m_unblockable = no_segment_can_block(scene);
+        // Walls on the scene's hull block nothing (engine/convex_scene.h):
+        // visibility skips them; with no blocker at all it is never asked.
+        const std::vector<char> blockers = possible_blockers(scene);
+        m_hierarchy.set_blockers(blockers);
+        m_unblockable = std::find(blockers.begin(), blockers.end(), 1) == blockers.end();
         const Connectivity conn = scene_connectivity(scene);
         m_escape_free = escape_free_patches(scene, conn);
         m_visible_sink = visible_sinks(scene, conn);

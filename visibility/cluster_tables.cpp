@@ -91,8 +91,10 @@ void ClusterTables::build(int node) const {
     const ClusterNode& nd = m_hierarchy->node(node);
     std::vector<Segment> segs;
     segs.reserve(static_cast<size_t>(nd.count));
-    for (int k = nd.first; k < nd.first + nd.count; ++k)
-        segs.push_back(m_hierarchy->segments()[static_cast<size_t>(m_hierarchy->order()[static_cast<size_t>(k)])]);
+    for (int k = nd.first; k < nd.first + nd.count; ++k) {
+        const int s = m_hierarchy->order()[static_cast<size_t>(k)];
+        if (m_hierarchy->can_block(s)) segs.push_back(m_hierarchy->segments()[static_cast<size_t>(s)]);  // only blockers cast shadows
+    }
 
     auto t = std::make_unique<ClusterTable>();
     for (auto* v : {&t->delta_p, &t->tau_bar, &t->L1, &t->R2, &t->R2f, &t->R1}) v->resize(directions);

@@ -5,7 +5,8 @@
 /// For a cluster C (an axis-aligned box) and a direction theta, p runs over
 /// the offsets of the lines of direction theta that cross the box
 /// (width delta_p(theta)); tau_C(p, theta) is 1 when the line misses C's
-/// segments and 0 when it meets one (segments are opaque). Per sampled
+/// segments and 0 when it meets one (segments are opaque; only those that
+/// can block count, Hierarchy::set_blockers). Per sampled
 /// direction the table keeps:
 ///   tau_bar = mean of tau_C over the box's lines = 1 - |union of shadows| / delta_p;
 ///   L1  = || tau_C - tau_bar ||_L1 = 2 delta_p tau_bar (1 - tau_bar)   (exact: tau_C is 0/1);

@@ -263,7 +263,7 @@ double ExactVisibility::exchange(const Segment& i, const Segment& j, int skip_i,
     const double size = shaft.box.diagonal();
     ws.blockers.clear();
     bool separated = false;
-    stats.clusters_visited += m_hierarchy->query(
+    stats.clusters_visited += m_hierarchy->query_blockers(
         [&](const Box& b) { return !separated && shaft.overlaps(b); },
         [&](int s, const Segment& seg) {
             if (s == skip_i || s == skip_j || separated) return;

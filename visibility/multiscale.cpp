@@ -664,6 +664,7 @@ MultiscaleResult MultiscaleVisibility::form_factor_skipping(const Segment& i, co
     while (!stack.empty() && !separated) {
         const ClusterNode& n = m_hierarchy->node(stack.back());
         stack.pop_back();
+        if (n.blockers == 0) continue;  // nothing below can block (Hierarchy::set_blockers)
         ++out.clusters_visited;
         if (!shaft.overlaps(n.box)) continue;
         if (!n.leaf()) {
@@ -674,6 +675,7 @@ MultiscaleResult MultiscaleVisibility::form_factor_skipping(const Segment& i, co
         for (int q = n.first; q < n.first + n.count && !separated; ++q) {
             if (skipped(q)) continue;
             const int s = m_hierarchy->order()[static_cast<size_t>(q)];
+            if (!m_hierarchy->can_block(s)) continue;
             const size_t before = pieces.size();
             separated = add_blocker(shaft, m_hierarchy->segments()[static_cast<size_t>(s)], size, pieces);
             if (pieces.size() > before) piece_pos.push_back(q);

@@ -25,19 +25,23 @@ std::string polygon_scene(const std::vector<std::array<double, 2>>& pts, const s
                        p, extra);
 }
 
-// The definition, O(N^2): no endpoint strictly on both sides of any segment's line.
+// The definition, O(N^2): segment a is on the hull's boundary when no
+// endpoint lies strictly on both sides of its line.
+bool on_hull_oracle(const Scene& s, const SceneSegment& a) {
+    bool left = false, right = false;
+    for (const SceneSegment& b : s.segments)
+        for (Vec2 v : {b.seg.a, b.seg.b}) {
+            const double o = orient(a.seg.a, a.seg.b, v);
+            const double tol = 1e-9 * a.seg.length();
+            left = left || o > tol;
+            right = right || o < -tol;
+        }
+    return !(left && right);
+}
+
 bool oracle(const Scene& s) {
-    for (const SceneSegment& a : s.segments) {
-        bool left = false, right = false;
-        for (const SceneSegment& b : s.segments)
-            for (Vec2 v : {b.seg.a, b.seg.b}) {
-                const double o = orient(a.seg.a, a.seg.b, v);
-                const double tol = 1e-9 * a.seg.length();
-                left = left || o > tol;
-                right = right || o < -tol;
-            }
-        if (left && right) return false;
-    }
+    for (const SceneSegment& a : s.segments)
+        if (!on_hull_oracle(s, a)) return false;
     return true;
 }
 
@@ -83,4 +87,56 @@ TEST_CASE("no segment can block: agrees with the quadratic definition on random 
     }
     CHECK(convex >= 100);  // every regular polygon, so both answers were tested
     CHECK(convex < 200);
+}
+
+TEST_CASE("possible blockers: per segment, the quadratic definition, on polygons with plates inside") {
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> u(0, 1);
+    long hull = 0, inner = 0;
+    for (int trial = 0; trial < 100; ++trial) {
+        const int n = 3 + static_cast<int>(u(rng) * 40);
+        const bool round = trial % 2 == 0;
+        std::vector<std::array<double, 2>> pts;
+        for (int k = 0; k < n; ++k) {
+            const double a = 2 * std::numbers::pi * k / n;
+            const double r = round ? 1.0 : 0.5 + u(rng);
+            pts.push_back({r * std::cos(a), r * std::sin(a)});
+        }
+        // A few short plates well inside (radius < 0.3 of a polygon whose
+        // radii are >= 0.5, so inside it whatever its shape).
+        std::string plates;
+        const int m = trial % 4;
+        for (int k = 0; k < m; ++k) {
+            const double cx = -0.2 + 0.1 * k, cy = 0.3 * (u(rng) - 0.5);
+            plates += fmt::format(R"(, {{"name": "p{}", "material": "m", "side": "both", "points": [[{},{}],[{},{}]]}})", k,
+                                  cx, cy, cx + 0.05, cy + 0.05 * u(rng));
+        }
+        const Scene s = parse_scene(polygon_scene(pts, plates), "p");
+        const std::vector<char> blockers = possible_blockers(s);
+        REQUIRE(blockers.size() == s.segments.size());
+        for (size_t k = 0; k < s.segments.size(); ++k) {
+            CAPTURE(trial);
+            CAPTURE(k);
+            const bool on = on_hull_oracle(s, s.segments[k]);
+            CHECK(blockers[k] == (on ? 0 : 1));
+            (on ? hull : inner) += 1;
+        }
+        CHECK(no_segment_can_block(s) == oracle(s));
+    }
+    // Both answers were tested many times.
+    CHECK(hull > 500);
+    CHECK(inner > 200);
+}
+
+TEST_CASE("possible blockers: a circle's walls block nothing, a lamp inside it does") {
+    const Scene s = parse_scene(R"({"flatrad": 1, "materials": {"w": {"reflectance": 0.5}, "l": {"emission": 1}},
+        "surfaces": [{"name": "wall", "material": "w", "side": "in", "circle": {"center": [0, 0], "radius": 1, "segments": 999}},
+                     {"name": "lamp", "material": "l", "side": "left", "points": [[0.2, 0.95], [-0.2, 0.95]]}]})",
+                                "circle");
+    const std::vector<char> b = possible_blockers(s);
+    REQUIRE(b.size() == 1000);
+    long count = 0;
+    for (char c : b) count += c;
+    CHECK(count == 1);
+    CHECK(b.back() == 1);  // the lamp, read last
 }

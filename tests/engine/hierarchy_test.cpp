@@ -123,3 +123,43 @@ TEST_CASE("hierarchy: coincident segments do not split forever") {
     CHECK(h.nodes().size() == 1);
     CHECK(h.node(0).count == 100);
 }
+
+TEST_CASE("hierarchy: set_blockers counts per node, and query_blockers walks only them") {
+    std::mt19937_64 rng(8);
+    const auto segs = random_segments(rng, 2000);
+    Hierarchy h(segs, 1);
+    for (const ClusterNode& nd : h.nodes()) CHECK(nd.blockers == nd.count);  // all block by default
+    std::vector<char> can(segs.size(), 0);
+    std::uniform_real_distribution<double> U(0, 1);
+    for (auto& c : can) c = U(rng) < 0.1 ? 1 : 0;
+    h.set_blockers(can);
+    for (const ClusterNode& nd : h.nodes()) {
+        int expected = 0;
+        for (int k = nd.first; k < nd.first + nd.count; ++k) expected += can[static_cast<size_t>(h.order()[static_cast<size_t>(k)])];
+        CHECK(nd.blockers == expected);
+    }
+    std::vector<int32_t> stack;
+    for (int q = 0; q < 30; ++q) {
+        Box query;
+        query.add(Vec2{U(rng), U(rng)});
+        query.add(Vec2{U(rng), U(rng)});
+        std::set<int> found;
+        const long visited = h.query_blockers([&](const Box& b) { return overlap(b, query); },
+                                              [&](int s, const Segment& g) {
+                                                  Box gb;
+                                                  gb.add(g);
+                                                  if (overlap(gb, query)) found.insert(s);
+                                              },
+                                              stack);
+        std::set<int> expected;
+        for (size_t s = 0; s < segs.size(); ++s) {
+            Box gb;
+            gb.add(segs[s]);
+            if (can[s] && overlap(gb, query)) expected.insert(static_cast<int>(s));
+        }
+        CHECK(found == expected);
+        const long all = h.query([&](const Box& b) { return overlap(b, query); }, [](int, const Segment&) {}, stack);
+        CHECK(visited <= all);
+    }
+    CHECK_THROWS(h.set_blockers(std::vector<char>(3, 1)));
+}

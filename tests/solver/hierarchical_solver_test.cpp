@@ -171,6 +171,18 @@ TEST_CASE("hierarchical solver: pays for what the scene uses (DESIGN.md §4)") {
         {"name": "plate", "material": "w", "points": [[0.4,1],[1.2,1.1]], "side": "both"}]})",
                                       "blocked.json");
     CHECK(solve_hierarchical(blocked).stats.visibility.queries > 0);
+
+    // A round room of 400 walls with one lamp inside: only the lamp can
+    // block, so each query meets at most that one blocker (the walls on the
+    // hull are never walked: engine/convex_scene.h, Hierarchy::set_blockers).
+    const Scene round = parse_scene(R"({"flatrad": 1, "materials": {"w": {"reflectance": 0.5},
+        "l": {"reflectance": 0.5, "emission": 1}}, "surfaces": [
+        {"name": "wall", "material": "w", "side": "in", "circle": {"center": [0, 0], "radius": 1, "segments": 399}},
+        {"name": "lamp", "material": "l", "side": "left", "points": [[0.2, 0.95], [-0.2, 0.95]]}]})",
+                                    "round.json");
+    const Solution r = solve_hierarchical(round);
+    CHECK(r.stats.visibility.queries > 0);
+    CHECK(r.stats.visibility.blockers <= r.stats.visibility.queries);
 }
 
 TEST_CASE("hierarchical solver: review regressions (lit sides of a loop seeing its sinks, crossing loops, no links)") {
