@@ -651,8 +651,10 @@ LinkError HierarchicalSolver::link_error(const Link& l, const std::vector<double
                 rv += 0.25 * std::abs(form_factor_unoccluded(rq, s.seg) - l.Fu);
             }
         }
-        // A partly hidden sender may put a shadow boundary anywhere.
-        const double occlusion = std::max(0.0, std::min<double>(l.coef, l.Fu - l.coef));
+        // A partly hidden sender may put a shadow boundary anywhere on the
+        // receiver; a sink absorbs all it gets, wherever on it, so there
+        // only the accuracy of F itself counts.
+        const double occlusion = r.sink() ? 0.0 : std::max(0.0, std::min<double>(l.coef, l.Fu - l.coef));
         double err = power * (std::max(rv, sv) + occlusion + l.vis_err);
         // The link spreads the sender's mean, not its halves' values.
         if (s.child >= 0) {

@@ -15,6 +15,7 @@
 
 #include "cli/reference_solution.h"
 #include "cli/solution_error.h"
+#include "solver/hierarchical_solver.h"
 
 namespace CLI {
 class App;
@@ -28,7 +29,7 @@ inline constexpr long default_compare_max_elements = default_reference_max_eleme
 struct CompareArgs {
     std::string scene;        ///< scene file
     std::string output;       ///< JSON file; empty: stdout
-    double eps = 1e-2;        ///< hierarchical refinement tolerance, > 0
+    double eps = HierarchicalOptions{}.eps;  ///< hierarchical refinement tolerance, > 0 (solve's default)
     double vis_eps = -1;      ///< hierarchical visibility tolerance; < 0: eps / 10
     int subdivide = 16;       ///< first reference K, >= 1
     long max_elements = default_compare_max_elements; ///< largest exact mesh (patches x K) tried
