@@ -21,6 +21,7 @@
 #include "solver/closed_enclosure.h"
 #include "solver/directional.h"
 #include "solver/gmres.h"
+#include "solver/light_parts.h"
 #include "solver/reachability.h"
 #include "solver/rooms.h"
 #include "solver/sink_visibility.h"
@@ -110,6 +111,13 @@ struct LinkError {
     bool split_r = true;  // the receiver's side makes most of it
 };
 
+// An independent sub-scene (solver/light_parts.h): the nodes its light
+// moves through, ascending (parents first); its element leaves (indices
+// into m_leaves); its receivers (indices into m_receivers).
+struct Part {
+    std::vector<int> nodes, leaves, receivers;
+};
+
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
@@ -166,17 +174,23 @@ private:
     bool make_link(int r, int s, Link& l, ExactWorkspace& ws, VisibilityStats& st) const;
     void compute_links(std::vector<Link>& links);
     int split_element(int node);
-    void pull_tables(const std::vector<double>& leaf_value, std::vector<double>& Bn, std::vector<double>& I) const;
+    void pull_tables(const double* leaf_value, std::vector<double>& Bn, std::vector<double>& I,
+                     const Part* part = nullptr) const;
     LinkError link_error(const Link& l, const std::vector<double>& Bn, const std::vector<double>& I) const;
     bool refine(const std::vector<double>& leaf_bmax);
     void collect_leaves();
     void reach();
     void sort_links();
-    void apply_G(const Eigen::VectorXd& x, Eigen::VectorXd& out, bool correct);
+    void apply_G(const Eigen::VectorXd& x, Eigen::VectorXd& out, bool correct, const Part* part = nullptr);
+    void build_parts();
+    bool in_part(const Part* part, int node, int parent) const {
+        return !part || m_part_of[static_cast<size_t>(parent)] == m_part_of[static_cast<size_t>(node)];
+    }
     void solve();
     std::vector<double> leaf_guess() const;
     std::vector<double> landed_fraction() const;
-    std::vector<double> push_down(std::vector<double>& tables, const std::vector<double>& own, double lobe_scale) const;
+    void push_down(std::vector<double>& tables, const std::vector<double>& own, double lobe_scale,
+                   std::vector<double>& above, const Part* part = nullptr) const;
 
     const Scene& m_scene;
     HierarchicalOptions m_opt;
@@ -214,6 +228,10 @@ private:
     std::vector<char> m_visible_sink;  // per segment side (solver/sink_visibility.h)
     std::vector<int> m_side_room;      // per segment side (solver/rooms.h)
 
+    // Independent sub-scenes, solved apart (after each refinement).
+    std::vector<Part> m_parts;
+    std::vector<int> m_part_of;  // per node: its part, -1 when none
+    long m_part_count = 0;
     // Scratch for the operator.
     std::vector<double> m_Bn, m_I, m_Hn, m_J, m_Ha;
     // Solution per channel, per node (B pulled, H pushed).
@@ -592,12 +610,25 @@ int HierarchicalSolver::split_element(int node) {
 
 // Pull: per node the length-weighted mean of `leaf_value` over element
 // leaves (Bn), per cluster table the exitance I(phi_k).
-void HierarchicalSolver::pull_tables(const std::vector<double>& leaf_value, std::vector<double>& Bn,
-                                     std::vector<double>& I) const {
+// With a part, only its nodes are zeroed and visited (the rest of Bn and I
+// is left as it was).
+void HierarchicalSolver::pull_tables(const double* leaf_value, std::vector<double>& Bn,
+                                     std::vector<double>& I, const Part* part) const {
     const size_t N = m_nodes.size();
-    Bn.assign(N, 0.0);
-    I.assign(static_cast<size_t>(m_tables_count) * K, 0.0);
-    for (size_t k = N; k-- > 0;) {
+    const size_t T = static_cast<size_t>(m_tables_count) * K;
+    if (!part || Bn.size() != N || I.size() != T) {
+        Bn.assign(N, 0.0);
+        I.assign(T, 0.0);
+    }
+    if (part)
+        for (int k : part->nodes) {
+            Bn[static_cast<size_t>(k)] = 0;
+            if (m_nodes[static_cast<size_t>(k)].table >= 0)
+                std::fill_n(&I[static_cast<size_t>(m_nodes[static_cast<size_t>(k)].table) * K], K, 0.0);
+        }
+    const size_t count = part ? part->nodes.size() : N;
+    for (size_t q = count; q-- > 0;) {
+        const size_t k = part ? static_cast<size_t>(part->nodes[q]) : q;
         const Node& n = m_nodes[k];
         if (n.kind == Kind::Element) {
             if (n.child < 0) {
@@ -608,7 +639,7 @@ void HierarchicalSolver::pull_tables(const std::vector<double>& leaf_value, std:
                 Bn[k] = 0.5 * (Bn[a] + Bn[a + 1]);  // halves of equal length
             }
         }
-        if (n.parent < 0) continue;
+        if (n.parent < 0 || !in_part(part, static_cast<int>(k), n.parent)) continue;
         const Node& p = m_nodes[static_cast<size_t>(n.parent)];
         if (p.table < 0) continue;
         double* dst = &I[static_cast<size_t>(p.table) * K];
@@ -766,7 +797,7 @@ std::vector<double> HierarchicalSolver::leaf_guess() const {
 // returns whether a link split.
 bool HierarchicalSolver::refine(const std::vector<double>& leaf_bmax) {
     std::vector<double> Bn, I;
-    pull_tables(leaf_bmax, Bn, I);
+    pull_tables(leaf_bmax.data(), Bn, I);
     // eps_abs = eps * W / N (see the header).
     CompensatedSum W;
     long patches = 0;
@@ -916,13 +947,18 @@ void HierarchicalSolver::reach() {
 // side reads its leaf cluster's parent table through its cosine lobe
 // (times lobe_scale), each element below gets its parent's own value plus
 // what reached the parent. Returns, per node, what reached it from above.
-std::vector<double> HierarchicalSolver::push_down(std::vector<double>& tables, const std::vector<double>& own,
-                                                  double lobe_scale) const {
+// With a part, only its nodes are visited and written (a part's top node
+// gets nothing from above: no link ends above it).
+void HierarchicalSolver::push_down(std::vector<double>& tables, const std::vector<double>& own, double lobe_scale,
+                                   std::vector<double>& above, const Part* part) const {
     const size_t N = m_nodes.size();
-    std::vector<double> above(N, 0.0);
-    for (size_t k = 0; k < N; ++k) {
+    if (!part || above.size() != N) above.assign(N, 0.0);
+    const size_t count = part ? part->nodes.size() : N;
+    for (size_t q = 0; q < count; ++q) {
+        const size_t k = part ? static_cast<size_t>(part->nodes[q]) : q;
         const Node& n = m_nodes[k];
-        if (n.parent < 0) continue;
+        above[k] = 0;
+        if (n.parent < 0 || !in_part(part, static_cast<int>(k), n.parent)) continue;
         const Node& p = m_nodes[static_cast<size_t>(n.parent)];
         if (n.cluster()) {
             if (n.table >= 0 && p.table >= 0) {
@@ -942,23 +978,32 @@ std::vector<double> HierarchicalSolver::push_down(std::vector<double>& tables, c
             above[k] = own[static_cast<size_t>(n.parent)] + above[static_cast<size_t>(n.parent)];
         }
     }
-    return above;
 }
 
 // G(x): pull the leaf radiosities x up (means and exitance tables), gather
 // along the links, push irradiance down to the leaves. With `correct`, a
 // closed leaf adds its row-sum deficit times its ancestors' mean arrival.
-void HierarchicalSolver::apply_G(const Eigen::VectorXd& x, Eigen::VectorXd& out, bool correct) {
+// With a part, x and out are still indexed by all element leaves, but only
+// the part's are read and written.
+void HierarchicalSolver::apply_G(const Eigen::VectorXd& x, Eigen::VectorXd& out, bool correct, const Part* part) {
     const size_t N = m_nodes.size();
-    std::vector<double> leaf(static_cast<size_t>(m_element_leaves));
-    for (size_t i = 0; i < leaf.size(); ++i) leaf[i] = x(static_cast<Eigen::Index>(i));
-    pull_tables(leaf, m_Bn, m_I);
-    m_Hn.assign(N, 0.0);
-    m_J.assign(static_cast<size_t>(m_tables_count) * K, 0.0);
+    const size_t T = static_cast<size_t>(m_tables_count) * K;
+    pull_tables(x.data(), m_Bn, m_I, part);
+    if (!part || m_Hn.size() != N || m_J.size() != T) {
+        m_Hn.assign(N, 0.0);
+        m_J.assign(T, 0.0);
+    }
+    if (part)
+        for (int k : part->nodes) {
+            m_Hn[static_cast<size_t>(k)] = 0;
+            if (m_nodes[static_cast<size_t>(k)].table >= 0)
+                std::fill_n(&m_J[static_cast<size_t>(m_nodes[static_cast<size_t>(k)].table) * K], K, 0.0);
+        }
     // Gather, in parallel over receivers.
-    const long R = static_cast<long>(m_receivers.size());
+    const long R = static_cast<long>(part ? part->receivers.size() : m_receivers.size());
 #pragma omp parallel for num_threads(m_threads) schedule(dynamic, 256) if (R > 16 * parallel_min_work)
-    for (long q = 0; q < R; ++q) {
+    for (long qq = 0; qq < R; ++qq) {
+        const long q = part ? part->receivers[static_cast<size_t>(qq)] : qq;
         const int r = m_receivers[static_cast<size_t>(q)];
         const Node& nr = m_nodes[static_cast<size_t>(r)];
         double h = 0;
@@ -979,9 +1024,11 @@ void HierarchicalSolver::apply_G(const Eigen::VectorXd& x, Eigen::VectorXd& out,
         if (!J) m_Hn[static_cast<size_t>(r)] = h;
     }
     // Push: tables down the clusters, then onto sides, then down elements.
-    m_Ha = push_down(m_J, m_Hn, 1.0);  // what arrived at ancestors (row-sum correction)
-    out.resize(static_cast<Eigen::Index>(m_element_leaves));
-    for (size_t i = 0; i < static_cast<size_t>(m_element_leaves); ++i) {
+    push_down(m_J, m_Hn, 1.0, m_Ha, part);  // m_Ha: what arrived at ancestors (row-sum correction)
+    if (out.size() != static_cast<Eigen::Index>(m_element_leaves)) out.setZero(static_cast<Eigen::Index>(m_element_leaves));
+    const size_t leaves = part ? part->leaves.size() : static_cast<size_t>(m_element_leaves);
+    for (size_t j = 0; j < leaves; ++j) {
+        const size_t i = part ? static_cast<size_t>(part->leaves[j]) : j;
         const size_t k = static_cast<size_t>(m_leaves[i]);
         double h = m_Hn[k] + m_Ha[k];
         // The deficit goes with the ancestors' arrivals (where the
@@ -1021,29 +1068,56 @@ void HierarchicalSolver::solve() {
     }
     reach();
     sort_links();
+    build_parts();
     m_B.assign(static_cast<size_t>(m_C), std::vector<double>(m_nodes.size(), 0.0));
     m_H = m_B;
-    GmresOptions go;
-    go.tolerance = gmres_tolerance;
-    go.restart = n > 200000 ? 20 : 60;  // the Krylov basis is n x restart doubles
     for (int c = 0; c < m_C; ++c) {
-        Eigen::VectorXd E(n), rho_l(n), x(n), g;
+        Eigen::VectorXd E(n), rho_l(n), x(n), g = Eigen::VectorXd::Zero(n);
         for (Eigen::Index i = 0; i < n; ++i) {
             const int node = m_leaves[static_cast<size_t>(i)];
             E(i) = emission(node, c);
             rho_l(i) = rho(node, c);
-            x(i) = E(i);
+            x(i) = E(i);  // a leaf in no part gathers nothing: B = E
         }
-        auto apply = [&](const Eigen::VectorXd& v) -> Eigen::VectorXd {
-            apply_G(v, g, true);
-            return v - rho_l.cwiseProduct(g);
-        };
-        double rel = 0;
-        m_iterations += gmres(apply, E, x, rel, go);
-        const Eigen::VectorXd r = E - apply(x);
+        // Each part apart: its own Krylov run on its own leaves, the
+        // operator restricted to its nodes and receivers. stats.iterations
+        // counts the longest run (the applications of the whole operator
+        // had the parts run side by side).
+        long longest = 0;
+        Eigen::VectorXd full = x;  // scratch: the whole leaf vector
+        for (const Part& part : m_parts) {
+            const Eigen::Index m = static_cast<Eigen::Index>(part.leaves.size());
+            if (m == 0) continue;
+            Eigen::VectorXd Ep(m), xp(m);
+            for (Eigen::Index j = 0; j < m; ++j) {
+                Ep(j) = E(part.leaves[static_cast<size_t>(j)]);
+                xp(j) = Ep(j);
+            }
+            auto apply = [&](const Eigen::VectorXd& v) -> Eigen::VectorXd {
+                for (Eigen::Index j = 0; j < m; ++j) full(part.leaves[static_cast<size_t>(j)]) = v(j);
+                apply_G(full, g, true, &part);
+                Eigen::VectorXd out(m);
+                for (Eigen::Index j = 0; j < m; ++j) {
+                    const Eigen::Index i = part.leaves[static_cast<size_t>(j)];
+                    out(j) = v(j) - rho_l(i) * g(i);
+                }
+                return out;
+            };
+            GmresOptions go;
+            go.tolerance = gmres_tolerance;
+            go.restart = m > 200000 ? 20 : 60;  // the Krylov basis is m x restart doubles
+            double rel = 0;
+            longest = std::max(longest, gmres(apply, Ep, xp, rel, go));
+            for (Eigen::Index j = 0; j < m; ++j) x(part.leaves[static_cast<size_t>(j)]) = xp(j);
+        }
+        m_iterations += longest;
+        // The whole operator once more: the residual of all parts together,
+        // and every node's values.
+        apply_G(x, g, true);
+        const Eigen::VectorXd r = E - (x - rho_l.cwiseProduct(g));
         const double scale = std::max(E.cwiseAbs().maxCoeff(), x.cwiseAbs().maxCoeff());
         if (scale > 0) m_residual = std::max(m_residual, r.cwiseAbs().maxCoeff() / scale);
-        // Per-node values of the final x (apply left m_Bn, m_Hn, m_Ha for it).
+        // Per-node values of the final x (the last apply left m_Bn, m_Hn, m_Ha for it).
         auto& B = m_B[static_cast<size_t>(c)];
         auto& H = m_H[static_cast<size_t>(c)];
         for (size_t k = 0; k < m_nodes.size(); ++k) {
@@ -1054,6 +1128,78 @@ void HierarchicalSolver::solve() {
         progress(fmt::format("solved channel {} of {}", c + 1, m_C), -1);
     }
     m_solve_time += seconds_since(t0);
+}
+
+// Independent sub-scenes (solver/light_parts.h) over the current links: a
+// leaf is coupled to its ancestors that end a link and a link couples its
+// ends. Each part that holds a link gets its nodes (every leaf's path up to
+// its highest linked ancestor), element leaves and receivers. With
+// solve_parts_apart off, one part holds everything (the test's oracle).
+void HierarchicalSolver::build_parts() {
+    const int N = static_cast<int>(m_nodes.size());
+    m_parts.clear();
+    m_part_of.assign(static_cast<size_t>(N), -1);
+    m_part_count = 0;
+    if (m_links.empty()) return;
+    std::vector<char> linked(static_cast<size_t>(N), 0);
+    std::vector<std::pair<int, int>> edges;
+    edges.reserve(m_links.size() + m_leaves.size());
+    for (const Link& l : m_links) {
+        linked[static_cast<size_t>(l.r)] = linked[static_cast<size_t>(l.s)] = 1;
+        if (l.r != l.s) edges.push_back({l.r, l.s});
+    }
+    for (int leaf : m_leaves)
+        for (int p = m_nodes[static_cast<size_t>(leaf)].parent; p >= 0; p = m_nodes[static_cast<size_t>(p)].parent)
+            if (linked[static_cast<size_t>(p)]) edges.push_back({leaf, p});
+    LightParts lp;
+    if (m_opt.solve_parts_apart) {
+        lp = connected_parts(N, edges);
+    } else {
+        lp.part.assign(static_cast<size_t>(N), 0);
+        lp.count = 1;
+    }
+    edges = {};
+    // Parts that hold a link, numbered in order of their first receiver.
+    std::vector<int> index(static_cast<size_t>(lp.count), -1);
+    for (size_t q = 0; q < m_receivers.size(); ++q) {
+        const int comp = lp.part[static_cast<size_t>(m_receivers[q])];
+        int& id = index[static_cast<size_t>(comp)];
+        if (id < 0) {
+            id = static_cast<int>(m_parts.size());
+            m_parts.emplace_back();
+        }
+        m_parts[static_cast<size_t>(id)].receivers.push_back(static_cast<int>(q));
+    }
+    m_part_count = static_cast<long>(m_parts.size());
+    for (size_t i = 0; i < m_leaves.size(); ++i) {
+        const int leaf = m_leaves[i];
+        const int id = index[static_cast<size_t>(lp.part[static_cast<size_t>(leaf)])];
+        if (id < 0) continue;  // gathers nothing, sends to no one
+        Part& part = m_parts[static_cast<size_t>(id)];
+        if (static_cast<int>(i) < m_element_leaves) part.leaves.push_back(static_cast<int>(i));
+        // Its path up to its highest linked ancestor; a node already taken
+        // has its path above taken too.
+        int top = leaf;
+        for (int p = m_nodes[static_cast<size_t>(leaf)].parent; p >= 0; p = m_nodes[static_cast<size_t>(p)].parent)
+            if (linked[static_cast<size_t>(p)]) top = p;
+        for (int k = leaf;; k = m_nodes[static_cast<size_t>(k)].parent) {
+            if (m_part_of[static_cast<size_t>(k)] >= 0) break;
+            m_part_of[static_cast<size_t>(k)] = id;
+            part.nodes.push_back(k);
+            if (k == top) break;
+        }
+    }
+    // A linked node with no leaf below in the part (a receiver whose leaves
+    // all lie elsewhere cannot be: pushes reach them) is still an end of a
+    // gather: keep it.
+    for (int k = 0; k < N; ++k)
+        if (linked[static_cast<size_t>(k)] && m_part_of[static_cast<size_t>(k)] < 0) {
+            const int id = index[static_cast<size_t>(lp.part[static_cast<size_t>(k)])];
+            if (id < 0) continue;
+            m_part_of[static_cast<size_t>(k)] = id;
+            m_parts[static_cast<size_t>(id)].nodes.push_back(k);
+        }
+    for (Part& part : m_parts) std::sort(part.nodes.begin(), part.nodes.end());
 }
 
 // Per node: the fraction of the power its element leaves send that the
@@ -1079,7 +1225,8 @@ std::vector<double> HierarchicalSolver::landed_fraction() const {
             own[static_cast<size_t>(l.s)] += d / s.length;
         }
     }
-    const std::vector<double> above = push_down(lam, own, 0.5);
+    std::vector<double> above;
+    push_down(lam, own, 0.5, above);
     std::vector<double> omega(N, 0.0);
     for (size_t k = 0; k < N; ++k) omega[k] = above[k] + own[k];
     return omega;
@@ -1177,6 +1324,7 @@ Solution HierarchicalSolver::run() {
     sol.stats.links = static_cast<long>(m_links.size());
     sol.stats.patches_left_out = m_left_out;
     sol.stats.cluster_links = m_cluster_links;
+    sol.stats.independent_parts = m_part_count;
     sol.stats.iterations = m_iterations;
     sol.stats.residual = m_residual;
     sol.stats.threads = m_threads;

@@ -47,7 +47,11 @@
 ///    gather along the links (in parallel over receivers), push (tables
 ///    down the clusters, cosine lobes onto the sides, irradiance down the
 ///    elements); (I - rho G) B = E by restarted GMRES (solver/gmres.h) to
-///    1e-12. stats.iterations counts operator applications.
+///    1e-12. Independent sub-scenes (solver/light_parts.h: no link and no
+///    shared linked ancestor between them) are solved apart, each with its
+///    own Krylov run on its own nodes; stats.independent_parts counts them,
+///    stats.iterations the longest run's operator applications. The
+///    residual is then checked on the whole operator.
 ///  - Row sums: a leaf whose light cannot leave the scene
 ///    (engine/connectivity.h) in a scene where no sink can be seen must
 ///    gather exactly 1 for B = 1 everywhere; its deficit (the refinement
@@ -83,6 +87,9 @@ struct HierarchicalOptions {
     int max_depth = 12;      ///< deepest element level (a patch is level 0)
     int max_passes = 8;      ///< refine-solve rounds at most
     int threads = 0;         ///< 0: all cores
+    /// Solve independent sub-scenes apart (solver/light_parts.h); off: one
+    /// Krylov run over everything (the same solution, for tests).
+    bool solve_parts_apart = true;
     /// Called now and then from the solving thread with what is being done
     /// ("refine pass 2", "solve", ...) and a fraction in [0, 1] of the whole
     /// run when one is known (< 0 otherwise). Empty: no reports. The CLI

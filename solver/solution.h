@@ -45,6 +45,7 @@ struct SolveStats {
     long iterations = 0;     ///< 0 for a direct solve
     long patches_left_out = 0;  ///< hierarchical: patches no emitter can reach (not solved; B = E = 0)
     long cluster_links = 0;     ///< hierarchical: links with a cluster at either end (part of `links`)
+    long independent_parts = 0; ///< hierarchical: sub-scenes no light passes between, solved apart
     double residual = 0;     ///< max over channels of ||(I - rho F) B - E||_inf / ||E||_inf
     int threads = 1;
     VisibilityStats visibility;

@@ -270,8 +270,10 @@ double adaptive_simpson(const F& f, double a, double b, double fa, double tol, i
     return left + adaptive_simpson(f, m, b, fm, tol / 2, depth + 1, err, evals, fb);
 }
 
-// Same splitting rule as the exact integral: shafts crowded with exact
-// blockers are halved, so that critical directions stay few.
+// Same splitting rule as the exact integral: shafts crowded with pieces
+// (exact blockers and approximated clusters: both bring critical
+// directions, O(pieces^2) of them) are halved, so that critical directions
+// stay few; each half keeps only the clusters whose box meets it.
 constexpr size_t mixed_split_threshold = 16;
 constexpr int mixed_max_depth = 12;
 
@@ -280,37 +282,43 @@ constexpr int mixed_max_depth = 12;
 // directions of the exact blockers; crowded shafts are split first.
 struct MixedIntegral {
     const Hierarchy& hierarchy;
-    const std::vector<Approx>& approx_world;
     ExactWorkspace& ws;
     VisibilityStats& stats;
     long arcs, evals;
     double err;
 
-    double solve(const Segment& ci, const Segment& cj, const Segment* candidates, size_t count, double tol,
-                 int depth) {
+    double solve(const Segment& ci, const Segment& cj, const Segment* candidates, size_t count,
+                 const std::vector<Approx>& approx_in, double tol, int depth) {
         if (ws.levels.size() <= static_cast<size_t>(depth)) ws.levels.resize(static_cast<size_t>(depth) + 1);
         std::vector<Segment>& mine = ws.levels[static_cast<size_t>(depth)];
-        if (clip_candidates(Shaft(ci, cj), candidates, count, mine)) {
+        const Shaft shaft(ci, cj);
+        if (clip_candidates(shaft, candidates, count, mine)) {
             ++stats.separated;
             return 0;
         }
-        const bool no_progress = depth > 0 && static_cast<double>(mine.size()) > 0.8 * static_cast<double>(count);
-        if (mine.size() > mixed_split_threshold && depth < mixed_max_depth && !no_progress) {
+        std::vector<Approx> approx;
+        approx.reserve(approx_in.size());
+        for (const Approx& a : approx_in)
+            if (shaft.overlaps(hierarchy.node(a.node).box)) approx.push_back(a);
+        const size_t pieces_here = mine.size() + approx.size(), pieces_above = count + approx_in.size();
+        const bool no_progress = depth > 0 && static_cast<double>(pieces_here) > 0.8 * static_cast<double>(pieces_above);
+        if (pieces_here > mixed_split_threshold && depth < mixed_max_depth && !no_progress) {
             ++stats.subshafts;
             const std::vector<Segment> pieces = mine;  // deeper levels reuse ws.levels
             if (ci.length() >= cj.length()) {
                 const Vec2 m = ci.midpoint();
-                return solve({ci.a, m}, cj, pieces.data(), pieces.size(), tol / 2, depth + 1) +
-                       solve({m, ci.b}, cj, pieces.data(), pieces.size(), tol / 2, depth + 1);
+                return solve({ci.a, m}, cj, pieces.data(), pieces.size(), approx, tol / 2, depth + 1) +
+                       solve({m, ci.b}, cj, pieces.data(), pieces.size(), approx, tol / 2, depth + 1);
             }
             const Vec2 m = cj.midpoint();
-            return solve(ci, {cj.a, m}, pieces.data(), pieces.size(), tol / 2, depth + 1) +
-                   solve(ci, {m, cj.b}, pieces.data(), pieces.size(), tol / 2, depth + 1);
+            return solve(ci, {cj.a, m}, pieces.data(), pieces.size(), approx, tol / 2, depth + 1) +
+                   solve(ci, {m, cj.b}, pieces.data(), pieces.size(), approx, tol / 2, depth + 1);
         }
-        return integrate(ci, cj, mine, tol);
+        return integrate(ci, cj, mine, approx, tol);
     }
 
-    double integrate(const Segment& ci, const Segment& cj, const std::vector<Segment>& exact, double tol) {
+    double integrate(const Segment& ci, const Segment& cj, const std::vector<Segment>& exact,
+                     const std::vector<Approx>& approx_here, double tol) {
         // Frame (shaft.h): origin at the shorter patch, axis bisecting the directions.
         PairGeometry g;
         g.visible = true;
@@ -327,7 +335,7 @@ struct MixedIntegral {
             pts.push_back(local(b.a));
             pts.push_back(local(b.b));
         }
-        std::vector<Approx> approx = approx_world;
+        std::vector<Approx> approx = approx_here;
         for (Approx& a : approx) {
             const Box& b = hierarchy.node(a.node).box;
             const Vec2 c[4] = {b.lo, {b.hi.x, b.lo.y}, b.hi, {b.lo.x, b.hi.y}};
@@ -740,8 +748,8 @@ MultiscaleResult MultiscaleVisibility::form_factor_skipping(const Segment& i, co
     // 3. Otherwise integrate over directions numerically.
     for (Approx& a : approx) a.table = &m_tables->table(a.node);
     const double tol = quadrature_share * std::max(eps, 1e-15) * 2 * g.L_i;
-    MixedIntegral mi{*m_hierarchy, approx, ws, stats, 0, 0, 0};
-    const double integral = mi.solve(g.ci, g.cj, exact.data(), exact.size(), tol, 0);
+    MixedIntegral mi{*m_hierarchy, ws, stats, 0, 0, 0};
+    const double integral = mi.solve(g.ci, g.cj, exact.data(), exact.size(), approx, tol, 0);
     out.arcs = mi.arcs;
     out.evaluations = mi.evals;
     out.F = std::max(0.0, integral / 2 / g.L_i);

@@ -84,6 +84,7 @@ ordered_json result_json(const Scene& scene, const Solution& solution) {
     stats["iterations"] = s.iterations;
     stats["patches_left_out"] = s.patches_left_out;
     stats["cluster_links"] = s.cluster_links;
+    stats["independent_parts"] = s.independent_parts;
     stats["residual"] = s.residual;
     stats["threads"] = s.threads;
     stats["form_factor_time_s"] = s.form_factor_time_s;

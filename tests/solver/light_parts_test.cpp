@@ -1,0 +1,93 @@
+// Independent sub-scenes (solver/light_parts.h) and the hierarchical solver
+// solving them apart: the same solution as one Krylov run over everything.
+#include "solver/light_parts.h"
+
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "engine/scene.h"
+#include "solver/hierarchical_solver.h"
+
+using namespace flatrad;
+
+TEST_CASE("connected parts: components of a small graph, isolated vertices alone") {
+    // 0-1-2, 3-4, 5 alone, 6-6 (a loop on itself).
+    const LightParts p = connected_parts(7, {{0, 1}, {2, 1}, {4, 3}, {6, 6}});
+    CHECK(p.count == 4);
+    CHECK(p.part[0] == p.part[1]);
+    CHECK(p.part[1] == p.part[2]);
+    CHECK(p.part[3] == p.part[4]);
+    CHECK(p.part[0] != p.part[3]);
+    CHECK(p.part[5] != p.part[0]);
+    CHECK(p.part[5] != p.part[3]);
+    CHECK(p.part[6] != p.part[5]);
+    // Numbered in order of first vertex.
+    CHECK(p.part[0] == 0);
+    CHECK(p.part[3] == 1);
+    CHECK(p.part[5] == 2);
+    CHECK(p.part[6] == 3);
+    CHECK(connected_parts(0, {}).count == 0);
+}
+
+namespace {
+
+// Two closed rooms side by side (a wall apart), each with its own lamp and
+// furniture, and a third, dark room: no light passes between them.
+std::string three_rooms(double rho_b) {
+    return R"({"flatrad": 1, "name": "three rooms",
+  "materials": {"wall": {"reflectance": [0.6, 0.5, 0.4]}, "lamp": {"emission": [4, 3, 2]},
+                "b": {"reflectance": [)" +
+           std::to_string(rho_b) + R"(, 0.9, 0.2]}, "lamp2": {"emission": [1, 2, 3], "reflectance": 0.1}},
+  "surfaces": [
+    {"name": "room a", "material": "wall", "closed": true, "side": "in", "points": [[0,0],[2,0],[2,1],[0,1]]},
+    {"name": "lamp a", "material": "lamp", "points": [[0.8,0.95],[1.2,0.95]], "side": "right"},
+    {"name": "plate a", "material": "b", "points": [[0.4,0.3],[0.9,0.5]], "side": "both"},
+    {"name": "room b", "material": "b", "closed": true, "side": "in", "points": [[3,0],[4,0],[4,2],[3,2]]},
+    {"name": "lamp b", "material": "lamp2", "points": [[3.2,0.1],[3.2,0.6]], "side": "left"},
+    {"name": "pillar b", "material": "wall", "circle": {"center": [3.6, 1.2], "radius": 0.2, "segments": 12}, "side": "out"},
+    {"name": "room c", "material": "wall", "closed": true, "side": "in", "points": [[5,0],[6,0],[6,1],[5,1]]}
+  ]})";
+}
+
+// GMRES stops at ||r||_2 <= 1e-12 ||E||_2 in either run (per part, or over
+// everything), and ||E||_2 <= sqrt(n) max E with n ~ 1000 leaves here; with
+// reflectances <= 0.9 the operator's inverse is at most ~10 in norm, so the
+// two solutions agree to ~3e-10 of the largest radiosity (not of each
+// patch's: a dim patch's own digits are not what the residual controls):
+// allowed 1e-9 of the largest.
+constexpr double same_solution_tol = 1e-9;
+
+}  // namespace
+
+TEST_CASE("hierarchical solver: independent rooms are solved apart, to the same solution") {
+    for (double rho_b : {0.3, 0.9}) {
+        const Scene scene = parse_scene(three_rooms(rho_b), "three.json");
+        HierarchicalOptions apart, together;
+        together.solve_parts_apart = false;
+        const Solution a = solve_hierarchical(scene, apart);
+        const Solution t = solve_hierarchical(scene, together);
+        CAPTURE(rho_b);
+        CHECK(a.stats.independent_parts == 2);  // the dark room has no links
+        CHECK(t.stats.independent_parts == 1);
+        CHECK(a.stats.patches_left_out > 0);    // room c
+        CHECK(a.stats.links == t.stats.links);
+        CHECK(a.stats.residual <= 1e-11);
+        double worst = 0, largest = 0;
+        for (size_t p = 0; p < scene.patches.size(); ++p)
+            for (int c = 0; c < scene.channels; ++c) {
+                const double x = a.patches[p].radiosity[static_cast<size_t>(c)];
+                const double y = t.patches[p].radiosity[static_cast<size_t>(c)];
+                worst = std::max(worst, std::abs(x - y));
+                largest = std::max(largest, std::abs(y));
+                if (y == 0) CHECK(x == 0);
+            }
+        REQUIRE(largest > 0);
+        CHECK(worst <= same_solution_tol * largest);
+        for (int c = 0; c < scene.channels; ++c)
+            CHECK(std::abs(a.totals.absorbed[static_cast<size_t>(c)] - t.totals.absorbed[static_cast<size_t>(c)]) <=
+                  same_solution_tol * t.totals.absorbed[static_cast<size_t>(c)]);
+    }
+}
