@@ -888,7 +888,17 @@ void HierarchicalSolver::collect_leaves() {
 // Groups links by receiver (CSR) so that the gather runs in parallel over
 // receivers without races.
 void HierarchicalSolver::sort_links() {
-    std::sort(m_links.begin(), m_links.end(), [](const Link& a, const Link& b) { return a.r < b.r || (a.r == b.r && a.s < b.s); });
+    // Counting sort by receiver (stable: a receiver's links keep their
+    // order, which is deterministic): O(links + nodes), where a comparison
+    // sort of tens of millions of links took a tenth of a large solve.
+    {
+        std::vector<int32_t> start(m_nodes.size() + 1, 0);
+        for (const Link& l : m_links) ++start[static_cast<size_t>(l.r) + 1];
+        for (size_t k = 1; k < start.size(); ++k) start[k] += start[k - 1];
+        std::vector<Link> sorted(m_links.size());
+        for (const Link& l : m_links) sorted[static_cast<size_t>(start[static_cast<size_t>(l.r)]++)] = l;
+        m_links.swap(sorted);
+    }
     m_receivers.clear();
     m_link_start.clear();
     for (size_t k = 0; k < m_links.size(); ++k)
