@@ -8,6 +8,7 @@
 #include <cmath>
 #include <limits>
 #include <mutex>
+#include <numbers>
 #include <shared_mutex>
 #include <unordered_map>
 #include <fmt/format.h>
@@ -142,6 +143,7 @@ public:
         m_escape_free = escape_free_patches(scene, conn);
         m_visible_sink = visible_sinks(scene, conn);
         m_side_room = side_rooms(scene, conn);
+        convex_object_skips(conn);
         const bool sinks = std::find(m_visible_sink.begin(), m_visible_sink.end(), 1) != m_visible_sink.end();
         // Row sums of 1 hold for escape-free patches when no sink can be seen.
         m_closed_patch.assign(scene.patches.size(), 0);
@@ -167,11 +169,13 @@ private:
         if (m_opt.progress) m_opt.progress(stage, fraction);
     }
     void refuse_closed_white() const;
+    void convex_object_skips(const Connectivity& conn);
     void build_tree();
     void endpoints(int node, std::vector<int>& out) const;
     void children_links(const Link& l, bool split_r, std::vector<Link>& out) const;
     void self_links(int node, std::vector<Link>& out) const;
     bool make_link(int r, int s, Link& l, ExactWorkspace& ws, VisibilityStats& st) const;
+    std::pair<double, double> link_transmittance(int r, int s, ExactWorkspace& ws, VisibilityStats& st) const;
     void compute_links(std::vector<Link>& links);
     int split_element(int node);
     void pull_tables(const double* leaf_value, std::vector<double>& Bn, std::vector<double>& I,
@@ -206,6 +210,11 @@ private:
     // (symmetric: the lines joining the two cross-sections).
     mutable std::unordered_map<uint64_t, std::pair<double, double>> m_tau_cache;
     mutable std::shared_mutex m_tau_mutex;
+    // Per hierarchy node: the node whose segments a transmittance from it
+    // does not count as blockers (itself, or its highest ancestor made of
+    // the same convex closed loop: see convex_object_skips).
+    std::vector<int32_t> m_tau_skip;
+    std::vector<int> m_patch_root;  // per patch: its element tree's root node
 
     std::vector<Node> m_nodes;
     int m_root = -1;
@@ -271,6 +280,56 @@ void HierarchicalSolver::refuse_closed_white() const {
             for (int a : closed) patches.push_back(white[static_cast<size_t>(a)]);
             flatrad::refuse_closed_white(m_scene, patches, c);
         }
+    }
+}
+
+// A convex closed loop (a pillar, a tube, a convex room) never stands
+// between one of its own faces and anything that face can see: light
+// leaving a lit side of a convex loop, outwards or inwards, does not meet
+// the loop again. A cluster link's transmittance is measured between
+// stand-ins that may lie inside the object (the chord of an arc of a
+// pillar), whose lines would cross the rest of it; so for a hierarchy node
+// made only of one convex loop's segments, the whole part of the hierarchy
+// made of that loop is skipped as blockers. Convex: certified simple
+// (engine/connectivity.h) and every turn of the polygon of the same sign
+// beyond rounding (unsure: not convex, and nothing changes).
+void HierarchicalSolver::convex_object_skips(const Connectivity& conn) {
+    const auto& hn = m_hierarchy.nodes();
+    m_tau_skip.resize(hn.size());
+    for (size_t h = 0; h < hn.size(); ++h) m_tau_skip[h] = static_cast<int32_t>(h);
+    std::vector<int> seg_loop(m_scene.segments.size(), -1);
+    for (size_t L = 0; L < conn.loops.size(); ++L) {
+        const SceneLoop& loop = conn.loops[L];
+        if (!loop.simple || loop.orientation == 0) continue;
+        const size_t n = loop.polygon.size();
+        bool convex = n >= 3;
+        for (size_t k = 0; k < n && convex; ++k) {
+            const Vec2 a = loop.polygon[(k + n - 1) % n], b = loop.polygon[k], c = loop.polygon[(k + 1) % n];
+            const double turn = orient(a, b, c);
+            const double len = norm(b - a) + norm(c - b);
+            convex = turn * loop.orientation > 1e-12 * len * len;
+        }
+        if (!convex) continue;
+        for (int sgm : loop.segments) seg_loop[static_cast<size_t>(sgm)] = static_cast<int>(L);
+    }
+    // Per node: the one convex loop all its segments are on, or -1.
+    std::vector<int> node_loop(hn.size(), -1);
+    for (size_t h = hn.size(); h-- > 0;) {  // children come after their parents
+        const ClusterNode& c = hn[h];
+        if (c.leaf()) {
+            int L = seg_loop[static_cast<size_t>(m_hierarchy.order()[static_cast<size_t>(c.first)])];
+            for (int32_t q = c.first + 1; q < c.first + c.count && L >= 0; ++q)
+                if (seg_loop[static_cast<size_t>(m_hierarchy.order()[static_cast<size_t>(q)])] != L) L = -1;
+            node_loop[h] = L;
+        } else {
+            const int a = node_loop[static_cast<size_t>(c.child[0])], b = node_loop[static_cast<size_t>(c.child[1])];
+            node_loop[h] = a == b ? a : -1;
+        }
+    }
+    for (size_t h = 0; h < hn.size(); ++h) {  // parents first
+        const int p = hn[h].parent;
+        if (node_loop[h] >= 0 && p >= 0 && node_loop[static_cast<size_t>(p)] == node_loop[h])
+            m_tau_skip[h] = m_tau_skip[static_cast<size_t>(p)];
     }
 }
 
@@ -353,6 +412,9 @@ void HierarchicalSolver::build_tree() {
         m_nodes[static_cast<size_t>(id)].child = first;
         m_nodes[static_cast<size_t>(id)].nchild = static_cast<int>(m_nodes.size()) - first;
     }
+    m_patch_root.assign(m_scene.patches.size(), -1);
+    for (size_t k = 0; k < m_nodes.size(); ++k)
+        if (m_nodes[k].kind == Kind::Element) m_patch_root[static_cast<size_t>(m_nodes[k].patch)] = static_cast<int>(k);
     // Directional tables for the clusters that are not hierarchy leaves
     // (links never end at a leaf cluster: at that level they go to the sides).
     for (Node& n : m_nodes)
@@ -525,27 +587,7 @@ bool HierarchicalSolver::make_link(int r, int s, Link& l, ExactWorkspace& ws, Vi
     }
     double tau = 1, terr = 0;
     if (!m_unblockable) {
-        // The same two hierarchy nodes come back many times (an element's
-        // halves keep their segment's node): one query per pair.
-        const uint64_t key = (static_cast<uint64_t>(std::min(nr.hnode, ns.hnode)) << 32) |
-                             static_cast<uint32_t>(std::max(nr.hnode, ns.hnode));
-        bool cached = false;
-        {
-            std::shared_lock lock(m_tau_mutex);
-            const auto it = m_tau_cache.find(key);
-            if (it != m_tau_cache.end()) {
-                tau = it->second.first;
-                terr = it->second.second;
-                cached = true;
-            }
-        }
-        if (!cached) {
-            const TransmittanceResult t = m_vis.transmittance(nr.hnode, ns.hnode, m_vis_eps, GammaRule::Bound, ws, st);
-            tau = t.tau;
-            terr = t.error_bound;
-            std::unique_lock lock(m_tau_mutex);
-            m_tau_cache.emplace(key, std::make_pair(tau, terr));
-        }
+        std::tie(tau, terr) = link_transmittance(r, s, ws, st);
     } else {
         ++st.unoccluded;
     }
@@ -554,6 +596,55 @@ bool HierarchicalSolver::make_link(int r, int s, Link& l, ExactWorkspace& ws, Vi
     l.vis_err = static_cast<float>(terr);
     l.coef = tau * coef_u;
     return true;
+}
+
+// Transmittance (and its bound) for a cluster link between nodes r and s,
+// cached: one query per pair of hierarchy nodes when both are clusters;
+// with an element (or sink) at one end, per element and hierarchy node, the
+// element being its own stand-in (multiscale.h), so that the halves of a
+// patch each get their own shadow. A half asks only when its patch's
+// answer is partial: a clear (or closed) shaft from the whole patch is clear
+// (closed) from any piece of it.
+std::pair<double, double> HierarchicalSolver::link_transmittance(int r, int s, ExactWorkspace& ws,
+                                                                 VisibilityStats& st) const {
+    const Node& nr = m_nodes[static_cast<size_t>(r)];
+    const Node& ns = m_nodes[static_cast<size_t>(s)];
+    const auto skip = [&](int h) { return m_tau_skip[static_cast<size_t>(h)]; };
+    auto cached = [&](uint64_t key, const auto& compute) {
+        {
+            std::shared_lock lock(m_tau_mutex);
+            const auto it = m_tau_cache.find(key);
+            if (it != m_tau_cache.end()) return it->second;
+        }
+        const TransmittanceResult t = compute();
+        std::unique_lock lock(m_tau_mutex);
+        m_tau_cache.emplace(key, std::make_pair(t.tau, t.error_bound));
+        return std::make_pair(t.tau, t.error_bound);
+    };
+    if (nr.cluster() && ns.cluster()) {
+        const uint64_t key = (static_cast<uint64_t>(std::min(nr.hnode, ns.hnode)) << 32) |
+                             static_cast<uint32_t>(std::max(nr.hnode, ns.hnode));
+        return cached(key, [&] {
+            return m_vis.transmittance(nr.hnode, ns.hnode, skip(nr.hnode), skip(ns.hnode), m_vis_eps, GammaRule::Bound,
+                                       ws, st);
+        });
+    }
+    const int e = nr.cluster() ? s : r;
+    const Node& other = nr.cluster() ? nr : ns;
+    auto for_element = [&](int node) {
+        const Node& n = m_nodes[static_cast<size_t>(node)];
+        const uint64_t key = (static_cast<uint64_t>(static_cast<uint32_t>(node) | 0x80000000u) << 32) |
+                             static_cast<uint32_t>(other.hnode);
+        return cached(key, [&] {
+            return m_vis.transmittance(n.seg, skip(n.hnode), other.hnode, skip(other.hnode), m_vis_eps,
+                                       GammaRule::Bound, ws, st);
+        });
+    };
+    const Node& ne = m_nodes[static_cast<size_t>(e)];
+    const int root = ne.kind == Kind::Element ? m_patch_root[static_cast<size_t>(ne.patch)] : e;
+    const auto whole = for_element(root);
+    const bool settled = whole.second == 0 && (whole.first == 0 || whole.first >= 1 - 1e-12);
+    return root == e || settled ? whole : for_element(e);
 }
 
 void HierarchicalSolver::compute_links(std::vector<Link>& links) {
@@ -713,23 +804,46 @@ LinkError HierarchicalSolver::link_error(const Link& l, const std::vector<double
         }
         return sent > 0 ? LinkError{inf, size_r >= size_s} : LinkError{};
     }
-    if (!(v > 0)) return {};
-    double sens = r.length, sens_err = 0;
+    const double dist = norm(r.center - s.center);
+    // The point approximation reads each table at one direction; over the
+    // nodes' extent the directions spread by +-delta, where a grazing lobe
+    // may be 0 at the centre's direction and not next to it. Range of the
+    // table over the spread: [lo, hi] (hi - lo: the variation the single
+    // reading misses, counted below as an error in its own right).
+    const double delta = std::min(std::numbers::pi, (r.radius + s.radius) / dist);
+    auto range = [&](const double* t, BinWeight b, double& lo, double& hi) {
+        const double h = 2 * std::numbers::pi / K, x = b.k + b.t;
+        int k0 = static_cast<int>(std::floor(x - delta / h)), k1 = static_cast<int>(std::ceil(x + delta / h));
+        if (k1 - k0 >= K) k1 = k0 + K - 1;
+        lo = std::numeric_limits<double>::infinity();
+        hi = 0;
+        for (int k = k0; k <= k1; ++k) {
+            const double val = t[((k % K) + K) % K];
+            lo = std::min(lo, val);
+            hi = std::max(hi, val);
+        }
+    };
+    double v_lo = v, v_hi = v;
+    if (s.cluster()) range(&I[static_cast<size_t>(s.table) * K], l.sbin, v_lo, v_hi);
+    if (!(v_hi > 0)) return {};
+    double sens = r.length, sens_err = 0, sens_lo = r.length, sens_hi = r.length;
     if (r.cluster()) {
         const double* t = &m_sensitivity[static_cast<size_t>(r.table) * K];
         sens = interpolate(t, l.rbin);
         sens_err = interpolation_error(t, l.rbin);
+        range(t, l.rbin, sens_lo, sens_hi);
     }
-    const double dist = norm(r.center - s.center);
     const double tau = l.tau;
     const double coef_u = tau > 0 ? l.coef / tau : 0;  // unoccluded coefficient
-    double unocc = 0;
-    if (coef_u > 0) {
-        unocc = coef_u * v * sens;
-    } else {
-        // Fully blocked but uncertain: bound with the unoccluded coefficient.
-        unocc = r.cluster() ? v * sens / dist : v * r.length / dist;
-    }
+    // The coefficient's own geometry at the highest reading (a cluster
+    // receiver or sender: 1 / d; an element's angle or cosine: its value
+    // when positive, else the bound L / d).
+    const double coef_hi = coef_u > 0 ? coef_u : (r.cluster() ? 1 / dist : r.length / dist);
+    const double unocc = coef_hi * v * sens;
+    // What the readings miss over the spread (grazing lobes, kinks), in
+    // power at full transmittance.
+    const double spread_s = coef_hi * (v_hi - v_lo) * std::max(sens, sens_hi);
+    const double spread_r = coef_hi * std::max(v, v_hi) * (sens_hi - sens_lo);
     // Relative errors by side:
     //  - point approximation: a node of radius rho seen from distance d
     //    changes direction and distance by ~rho / d over its extent (twice
@@ -762,8 +876,10 @@ LinkError HierarchicalSolver::link_error(const Link& l, const std::vector<double
     // and the transmittance is known to its bound. Splitting the larger
     // side narrows the shaft most.
     const double vis = std::min(tau, 1 - tau) + l.vis_err;
-    const double err = unocc * (rel_r + rel_s + vis);
-    const bool split_r = rel_r + (size_r >= size_s ? vis : 0) >= rel_s + (size_r < size_s ? vis : 0);
+    const double seen = std::min(1.0, tau + l.vis_err);
+    const double err = unocc * (rel_r + rel_s + vis) + seen * (spread_r + spread_s);
+    const bool split_r = unocc * rel_r + seen * spread_r + (size_r >= size_s ? unocc * vis : 0) >=
+                         unocc * rel_s + seen * spread_s + (size_r < size_s ? unocc * vis : 0);
     return {err, split_r};
 }
 

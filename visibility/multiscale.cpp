@@ -611,27 +611,88 @@ MultiscaleResult MultiscaleVisibility::form_factor(const Segment& i, const Segme
     return form_factor_skipping(i, j, range_of(skip_i), range_of(skip_j), eps, rule, ws, stats);
 }
 
+// Stand-ins for the two nodes' contents, facing each other: a lone
+// segment stands for itself; a cluster for the diagonal of its box that
+// its segments follow (ClusterNode::slope_moment: a wall piece's own
+// line, the chord of an arc). Lines from there reach the contents from
+// outside. A cross-section through the box centre, perpendicular to the
+// line joining the centres, samples lines from inside an object (an
+// arc of a pillar: through the rest of the pillar) or behind a wall:
+// on data/default.json cluster links carried 13-23% too little light
+// with it. A stand-in seen less than half as wide as its box (a
+// diagonal along the line of sight) gives way to that cross-section.
+// With `cross_section`, always the cross-section (the fall-back when the
+// chosen stand-ins cannot see each other: a wall piece's line through the
+// other's, say).
+static Segment node_stand_in(const Hierarchy& h, const ClusterNode& n, Vec2 toward, bool cross_section = false) {
+    const Vec2 centre = n.box.center();
+    const double d = distance(centre, toward);
+    const Vec2 u = d > 0 ? (toward - centre) / d : Vec2{1, 0}, v = rot90(u);
+    const Vec2 e = n.box.extent();
+    const double half = std::max(0.5 * (std::abs(e.x * v.x) + std::abs(e.y * v.y)), 1e-12 * d);
+    Segment s;
+    if (cross_section) {
+        s = {centre + v * half, centre - v * half};
+    } else if (n.count == 1) {
+        s = h.segments()[static_cast<size_t>(h.order()[static_cast<size_t>(n.first)])];
+    } else {
+        const Segment d1{n.box.lo, n.box.hi}, d2{{n.box.lo.x, n.box.hi.y}, {n.box.hi.x, n.box.lo.y}};
+        s = n.slope_moment >= 0 ? d1 : d2;
+    }
+    if (!(std::abs(dot(s.b - s.a, v)) >= half)) s = {centre + v * half, centre - v * half};
+    return orient(s.a, s.b, toward) >= 0 ? s : s.reversed();
+}
+
 TransmittanceResult MultiscaleVisibility::transmittance(int node_a, int node_b, double eps, GammaRule rule,
                                                         ExactWorkspace& ws, VisibilityStats& stats) const {
-    // Cross-sections through the box centres, perpendicular to the line
-    // joining them, as wide as each box seen along it, facing each other.
+    return transmittance(node_a, node_b, node_a, node_b, eps, rule, ws, stats);
+}
+
+TransmittanceResult MultiscaleVisibility::transmittance(int node_a, int node_b, int skip_a, int skip_b, double eps,
+                                                        GammaRule rule, ExactWorkspace& ws,
+                                                        VisibilityStats& stats) const {
     const ClusterNode& A = m_hierarchy->node(node_a);
     const ClusterNode& B = m_hierarchy->node(node_b);
     const Vec2 ca = A.box.center(), cb = B.box.center();
+    if (ca == cb) return {};
+    if (auto t = transmittance_between(node_stand_in(*m_hierarchy, A, cb), node_stand_in(*m_hierarchy, B, ca), skip_a,
+                                       skip_b, eps, rule, ws, stats))
+        return *t;
+    // Cross-sections through the centres face each other: never empty.
+    return transmittance_between(node_stand_in(*m_hierarchy, A, cb, true), node_stand_in(*m_hierarchy, B, ca, true),
+                                 skip_a, skip_b, eps, rule, ws, stats)
+        .value_or(TransmittanceResult{});
+}
+
+TransmittanceResult MultiscaleVisibility::transmittance(const Segment& a, int skip_a, int node_b, int skip_b,
+                                                        double eps, GammaRule rule, ExactWorkspace& ws,
+                                                        VisibilityStats& stats) const {
+    const ClusterNode& B = m_hierarchy->node(node_b);
+    for (bool cross_section : {false, true})
+        if (auto t = transmittance_between(a, node_stand_in(*m_hierarchy, B, a.midpoint(), cross_section), skip_a,
+                                           skip_b, eps, rule, ws, stats))
+            return *t;
+    // The segment sees neither stand-in (node_b's centre lies behind it or
+    // on its line): unknown, which makes the caller refine.
+    TransmittanceResult unknown;
+    unknown.tau = 1;
+    unknown.error_bound = 1;
+    return unknown;
+}
+
+// Empty when the two stand-ins cannot see each other (no line joins them
+// from lit side to lit side).
+std::optional<TransmittanceResult> MultiscaleVisibility::transmittance_between(const Segment& sa, const Segment& sb,
+                                                                               int skip_a, int skip_b, double eps,
+                                                                               GammaRule rule, ExactWorkspace& ws,
+                                                                               VisibilityStats& stats) const {
     TransmittanceResult out;
-    if (ca == cb) return out;
-    const Vec2 u = (cb - ca) / distance(ca, cb), v = rot90(u);
-    auto half_width = [&](const Box& b) {
-        const Vec2 e = b.extent();
-        return 0.5 * (std::abs(e.x * v.x) + std::abs(e.y * v.y));
-    };
-    const double ha = std::max(half_width(A.box), 1e-12 * distance(ca, cb));
-    const double hb = std::max(half_width(B.box), 1e-12 * distance(ca, cb));
-    const Segment sa{ca + v * ha, ca - v * ha}, sb{cb - v * hb, cb + v * hb};  // lit sides face each other
     const double unoccluded = form_factor_unoccluded(sa, sb);
-    if (!(unoccluded > 0)) return out;
-    const MultiscaleResult r = form_factor_skipping(sa, sb, SkipRange{A.first, A.count}, SkipRange{B.first, B.count},
-                                                    eps * unoccluded, rule, ws, stats);
+    if (!(unoccluded > 0)) return std::nullopt;
+    const ClusterNode& SA = m_hierarchy->node(skip_a);
+    const ClusterNode& SB = m_hierarchy->node(skip_b);
+    const MultiscaleResult r = form_factor_skipping(sa, sb, SkipRange{SA.first, SA.count},
+                                                    SkipRange{SB.first, SB.count}, eps * unoccluded, rule, ws, stats);
     out.tau = std::min(1.0, r.F / unoccluded);
     out.error_bound = r.error_bound / unoccluded;
     out.clusters_visited = r.clusters_visited;

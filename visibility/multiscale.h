@@ -91,15 +91,30 @@ public:
                                  GammaRule rule, ExactWorkspace& ws, VisibilityStats& stats) const;
 
     /// Transmittance between hierarchy nodes a and b with tolerance eps on
-    /// tau: the occluded over the unoccluded form factor between the two
-    /// boxes' cross-sections (segments through their centres, perpendicular
-    /// to the line joining them, as wide as each box seen along it, facing
-    /// each other), the segments inside a and b not counted as blockers.
-    /// The cross-sections stand in for the boxes: lines meeting both boxes
-    /// but missing a cross-section are not sampled (an approximation of the
-    /// link's geometry, not of visibility).
+    /// tau: the occluded over the unoccluded form factor between two
+    /// stand-ins for their contents, facing each other (a lone segment
+    /// itself; a cluster the diagonal of its box its segments follow; a
+    /// cross-section through the centre when that diagonal is seen edge-on:
+    /// see multiscale.cpp), the segments inside a and b not counted as
+    /// blockers. The stand-ins sample the lines between the nodes: lines
+    /// meeting both boxes but missing a stand-in are not sampled (an
+    /// approximation of the link's geometry, not of visibility).
     TransmittanceResult transmittance(int node_a, int node_b, double eps, GammaRule rule, ExactWorkspace& ws,
                                       VisibilityStats& stats) const;
+    /// The same with the segments of hierarchy nodes skip_a and skip_b (an
+    /// ancestor of node_a, of node_b, or the node itself) not counted as
+    /// blockers: the caller knows they cannot stand between the two (e.g.
+    /// the rest of a convex closed object node_a is part of, whose outward
+    /// faces see nothing of it).
+    TransmittanceResult transmittance(int node_a, int node_b, int skip_a, int skip_b, double eps, GammaRule rule,
+                                      ExactWorkspace& ws, VisibilityStats& stats) const;
+    /// The same between a segment (oriented lit-left, e.g. an element of a
+    /// patch, which is its own stand-in) and node_b; the segments of
+    /// skip_a (its segment's leaf, or an ancestor) and skip_b not blockers.
+    /// When the segment sees no stand-in of node_b (its centre behind the
+    /// segment's line): tau 1 with error bound 1 (unknown).
+    TransmittanceResult transmittance(const Segment& a, int skip_a, int node_b, int skip_b, double eps,
+                                      GammaRule rule, ExactWorkspace& ws, VisibilityStats& stats) const;
 
     /// The criteria of `node` for the pair (i, j) (unclipped, lit-left).
     /// Infinite when the pair cannot see each other.
@@ -108,6 +123,9 @@ public:
     const ClusterTables& tables() const { return *m_tables; }
 
 private:
+    std::optional<TransmittanceResult> transmittance_between(const Segment& sa, const Segment& sb, int skip_a,
+                                                             int skip_b, double eps, GammaRule rule,
+                                                             ExactWorkspace& ws, VisibilityStats& stats) const;
     /// Positions [first, first + count) in the hierarchy's order.
     struct SkipRange {
         int32_t first = 0, count = 0;
