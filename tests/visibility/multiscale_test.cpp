@@ -149,3 +149,39 @@ TEST_CASE("multiscale: transmittance between clusters is in [0, 1] and within it
     const MultiscaleVisibility lm(lone, lt);
     CHECK(lm.transmittance(1, 2, 0.0, GammaRule::Bound, ws, st).tau == doctest::Approx(1.0).epsilon(1e-14));
 }
+
+TEST_CASE("multiscale: transmittance from a segment is the exact occluded share of its exchange") {
+    // Plate a = [0,0]-[0,1] facing +x; a lone segment b at x = 4 (node 2 of
+    // a three-segment hierarchy); a blocker at x = 2 covering y in [0.3, 0.7].
+    const Segment a{{0, 1}, {0, 0}};  // lit side (left of a -> b) faces +x
+    const Segment b{{4, 0}, {4, 1}};  // lit side faces -x
+    const Segment blocker{{2, 0.3}, {2, 0.7}};
+    const Hierarchy h({a, b, blocker}, 1);
+    const ClusterTables tables(h);
+    const MultiscaleVisibility ms(h, tables);
+    ExactWorkspace ws;
+    VisibilityStats st;
+    int leaf_a = -1, leaf_b = -1;
+    for (int k = 0; k < static_cast<int>(h.nodes().size()); ++k)
+        if (h.node(k).leaf()) {
+            const int seg = h.order()[static_cast<size_t>(h.node(k).first)];
+            if (seg == 0) leaf_a = k;
+            if (seg == 1) leaf_b = k;
+        }
+    REQUIRE(leaf_a >= 0);
+    REQUIRE(leaf_b >= 0);
+    const ExactVisibility exact(h);
+    const double F = exact.form_factor(a, b, 0, 1, ws, st);
+    const double Fu = form_factor_unoccluded(a, b);
+    const TransmittanceResult t = ms.transmittance(a, leaf_a, leaf_b, leaf_b, 0.0, GammaRule::Bound, ws, st);
+    // Same lines, same blocker: the two ratios agree to rounding (~1e-15).
+    CHECK(t.tau == doctest::Approx(F / Fu).epsilon(1e-12));
+    CHECK(t.tau > 0.2);
+    CHECK(t.tau < 0.9);
+    // The node's lone segment is its own stand-in, in either orientation.
+    CHECK(ms.transmittance(leaf_a, leaf_b, 0.0, GammaRule::Bound, ws, st).tau == doctest::Approx(F / Fu).epsilon(1e-12));
+    // A segment facing away from the node sees no stand-in: unknown.
+    const TransmittanceResult away = ms.transmittance(a.reversed(), leaf_a, leaf_b, leaf_b, 0.0, GammaRule::Bound, ws, st);
+    CHECK(away.tau == 1);
+    CHECK(away.error_bound == 1);
+}
