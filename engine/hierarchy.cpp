@@ -147,18 +147,6 @@ Hierarchy::Hierarchy(const std::vector<Segment>& segments, int leaf_size) : m_se
         m_nodes[static_cast<size_t>(k)] = nd;
     }
     for (ClusterNode& nd : m_nodes) nd.blockers = nd.count;
-    for (size_t k = m_nodes.size(); k-- > 0;) {  // children come after their parents
-        ClusterNode& nd = m_nodes[k];
-        if (nd.leaf()) {
-            for (int32_t q = nd.first; q < nd.first + nd.count; ++q) {
-                const Segment& g = m_segments[static_cast<size_t>(m_order[static_cast<size_t>(q)])];
-                nd.slope_moment += (g.b.x - g.a.x) * (g.b.y - g.a.y);
-            }
-        } else {
-            nd.slope_moment = m_nodes[static_cast<size_t>(nd.child[0])].slope_moment +
-                              m_nodes[static_cast<size_t>(nd.child[1])].slope_moment;
-        }
-    }
 }
 
 void Hierarchy::set_blockers(const std::vector<char>& can_block) {

@@ -27,7 +27,6 @@ struct ClusterNode {
     int32_t count = 0;
     int32_t depth = 0;
     int32_t blockers = 0;    ///< how many of them can block (all, unless Hierarchy::set_blockers said otherwise)
-    double slope_moment = 0; ///< sum over its segments of dx dy: > 0 when they mostly rise (the box's lo-hi diagonal follows them)
     bool leaf() const { return child[0] < 0; }
 };
 

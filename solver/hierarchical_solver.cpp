@@ -287,8 +287,8 @@ void HierarchicalSolver::refuse_closed_white() const {
 // between one of its own faces and anything that face can see: light
 // leaving a lit side of a convex loop, outwards or inwards, does not meet
 // the loop again. A cluster link's transmittance is measured between
-// stand-ins that may lie inside the object (the chord of an arc of a
-// pillar), whose lines would cross the rest of it; so for a hierarchy node
+// stand-ins that may lie inside the object (the cross-section of an arc of
+// a pillar), whose lines would cross the rest of it; so for a hierarchy node
 // made only of one convex loop's segments, the whole part of the hierarchy
 // made of that loop is skipped as blockers. Convex: certified simple
 // (engine/connectivity.h) and every turn of the polygon of the same sign

@@ -93,9 +93,9 @@ public:
     /// Transmittance between hierarchy nodes a and b with tolerance eps on
     /// tau: the occluded over the unoccluded form factor between two
     /// stand-ins for their contents, facing each other (a lone segment
-    /// itself; a cluster the diagonal of its box its segments follow; a
-    /// cross-section through the centre when that diagonal is seen edge-on:
-    /// see multiscale.cpp), the segments inside a and b not counted as
+    /// itself; a cluster its cross-section: through the box centre,
+    /// perpendicular to the line joining the centres, as wide as the box
+    /// seen along it), the segments inside a and b not counted as
     /// blockers. The stand-ins sample the lines between the nodes: lines
     /// meeting both boxes but missing a stand-in are not sampled (an
     /// approximation of the link's geometry, not of visibility).

@@ -163,22 +163,3 @@ TEST_CASE("hierarchy: set_blockers counts per node, and query_blockers walks onl
     }
     CHECK_THROWS(h.set_blockers(std::vector<char>(3, 1)));
 }
-
-TEST_CASE("hierarchy: slope_moment sums dx dy over each node's segments") {
-    std::mt19937_64 rng(9);
-    const auto segs = random_segments(rng, 500);
-    const Hierarchy h(segs, 2);
-    for (const ClusterNode& nd : h.nodes()) {
-        double m = 0, scale = 0;
-        for (int k = nd.first; k < nd.first + nd.count; ++k) {
-            const Segment& g = segs[static_cast<size_t>(h.order()[static_cast<size_t>(k)])];
-            m += (g.b.x - g.a.x) * (g.b.y - g.a.y);
-            scale += std::abs((g.b.x - g.a.x) * (g.b.y - g.a.y));
-        }
-        // Summed in another order: rounding of ~count ulps of the scale.
-        CHECK(std::abs(nd.slope_moment - m) <= 1e-12 * scale + 1e-300);
-    }
-    // An arc rising to the right follows the box's lo-hi diagonal.
-    const Hierarchy arc({Segment{{0, 0}, {1, 0.2}}, Segment{{1, 0.2}, {1.8, 0.8}}, Segment{{1.8, 0.8}, {2, 2}}}, 4);
-    CHECK(arc.node(arc.root()).slope_moment > 0);
-}
