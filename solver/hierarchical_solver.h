@@ -13,11 +13,14 @@
 ///      element <- element: F_rs, the exact average over r, from
 ///        MultiscaleVisibility with --vis-eps (absolute on F);
 ///      anything <- cluster, cluster <- element: point approximations at
-///        the nodes' centres, times the transmittance between the two
-///        hierarchy nodes (MultiscaleVisibility::transmittance, --vis-eps on
-///        tau); a link whose shaft holds no blocker never calls visibility,
-///        and a scene where no segment can block (engine/convex_scene.h)
-///        calls it never;
+///        the nodes' centres, times a transmittance from the visibility
+///        module (MultiscaleVisibility::transmittance, --vis-eps on tau):
+///        between two clusters' cross-sections, or between an element
+///        itself and a cluster's (asked per element only when its patch's
+///        shaft is partly blocked); a convex closed object's own segments
+///        never count as blockers of its faces. Walls on the scene's hull
+///        are never walked (engine/convex_scene.h), and a scene where no
+///        segment can block calls visibility never;
 ///      nodes in different rooms (solver/rooms.h: a closed loop between
 ///        them) get no link.
 ///  - Directional model (solver/directional.h): a cluster's exitance
@@ -36,7 +39,9 @@
 ///    (point approximation 2 rho / d per clustered side, the tables'
 ///    interpolation error from their second differences, layers hidden
 ///    inside a cluster: sensitivity beyond the box's width, min(tau, 1 -
-///    tau), the visibility bound); the side with the larger share is split.
+///    tau), the visibility bound; and where a table reads 0 at the centres'
+///    direction, its highest value over the nodes' angular spread: a
+///    grazing lobe); the side with the larger share is split.
 ///    Overlapping nodes (d <= rho_r + rho_s, or an element whose line cuts
 ///    the cluster's box) are always split when they carry light. The first
 ///    round refines against a guess (every patch at E + rho B_bar, B_bar
@@ -69,8 +74,8 @@
 ///    lose is the transport's own energy error: balance = |emitted -
 ///    absorbed - escaped| / emitted measures it (in a scene with no
 ///    escape-free patch, balance only checks the linear solve).
-///    Measured on data/default.json: 4.6e-2 at eps 1e-2, 5.7e-3 at 1e-3,
-///    1.5e-4 at 1e-4, 8e-5 at 3e-5.
+///    Measured on data/default.json: 3.0e-3 at eps 1e-2, 1.3e-3 at 3e-3,
+///    4.0e-4 at 1e-3, 7.5e-5 at 1e-4, 3.8e-5 at 3e-5.
 ///  - Refuses (InputError) a closed set of reflectance-1 patches without
 ///    absorber, as solve_exact does.
 #include <functional>
