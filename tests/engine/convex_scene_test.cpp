@@ -39,6 +39,21 @@ bool on_hull_oracle(const Scene& s, const SceneSegment& a) {
     return !(left && right);
 }
 
+// Star-shaped polygons: angles evenly spaced, radii random in [0.5, 1.5)
+// (convex when `round`: all radii 1, often not otherwise), 3 to 42
+// vertices, shifted by x_offset.
+std::vector<std::array<double, 2>> star_polygon(std::mt19937& rng, bool round, double x_offset) {
+    std::uniform_real_distribution<double> u(0, 1);
+    const int n = 3 + static_cast<int>(u(rng) * 40);
+    std::vector<std::array<double, 2>> pts;
+    for (int k = 0; k < n; ++k) {
+        const double a = 2 * std::numbers::pi * k / n;
+        const double r = round ? 1.0 : 0.5 + u(rng);
+        pts.push_back({x_offset + r * std::cos(a), r * std::sin(a)});
+    }
+    return pts;
+}
+
 bool oracle(const Scene& s) {
     for (const SceneSegment& a : s.segments)
         if (!on_hull_oracle(s, a)) return false;
@@ -67,20 +82,9 @@ TEST_CASE("no segment can block: convex rooms yes, anything inside or a reflex c
 
 TEST_CASE("no segment can block: agrees with the quadratic definition on random polygons and circles") {
     std::mt19937 rng(7);
-    std::uniform_real_distribution<double> u(0, 1);
     int convex = 0;
     for (int trial = 0; trial < 200; ++trial) {
-        // Star-shaped polygons: angles sorted, radii random (convex when the
-        // radii are equal, often not otherwise).
-        const int n = 3 + static_cast<int>(u(rng) * 40);
-        const bool round = trial % 2 == 0;
-        std::vector<std::array<double, 2>> pts;
-        for (int k = 0; k < n; ++k) {
-            const double a = 2 * std::numbers::pi * k / n;
-            const double r = round ? 1.0 : 0.5 + u(rng);
-            pts.push_back({1e3 * (trial % 3) + r * std::cos(a), r * std::sin(a)});
-        }
-        const Scene s = parse_scene(polygon_scene(pts), "p");
+        const Scene s = parse_scene(polygon_scene(star_polygon(rng, trial % 2 == 0, 1e3 * (trial % 3))), "p");
         CAPTURE(trial);
         CHECK(no_segment_can_block(s) == oracle(s));
         convex += oracle(s) ? 1 : 0;
@@ -94,14 +98,7 @@ TEST_CASE("possible blockers: per segment, the quadratic definition, on polygons
     std::uniform_real_distribution<double> u(0, 1);
     long hull = 0, inner = 0;
     for (int trial = 0; trial < 100; ++trial) {
-        const int n = 3 + static_cast<int>(u(rng) * 40);
-        const bool round = trial % 2 == 0;
-        std::vector<std::array<double, 2>> pts;
-        for (int k = 0; k < n; ++k) {
-            const double a = 2 * std::numbers::pi * k / n;
-            const double r = round ? 1.0 : 0.5 + u(rng);
-            pts.push_back({r * std::cos(a), r * std::sin(a)});
-        }
+        const std::vector<std::array<double, 2>> pts = star_polygon(rng, trial % 2 == 0, 0.0);
         // A few short plates well inside (radius < 0.3 of a polygon whose
         // radii are >= 0.5, so inside it whatever its shape).
         std::string plates;

@@ -24,6 +24,25 @@ std::vector<Segment> random_segments(std::mt19937_64& rng, int n) {
 bool overlap(const Box& a, const Box& b) {
     return !(a.hi.x < b.lo.x || a.lo.x > b.hi.x || a.hi.y < b.lo.y || a.lo.y > b.hi.y);
 }
+Box random_box(std::mt19937_64& rng) {
+    std::uniform_real_distribution<double> U(0, 1);
+    Box b;
+    b.add(Vec2{U(rng), U(rng)});
+    b.add(Vec2{U(rng), U(rng)});
+    return b;
+}
+bool box_meets(const Segment& g, const Box& query) {
+    Box gb;
+    gb.add(g);
+    return overlap(gb, query);
+}
+// The segments whose boxes meet `query` (only those with keep[s], if given).
+std::set<int> linear_scan(const std::vector<Segment>& segs, const Box& query, const std::vector<char>* keep = nullptr) {
+    std::set<int> out;
+    for (size_t s = 0; s < segs.size(); ++s)
+        if ((!keep || (*keep)[s]) && box_meets(segs[s], query)) out.insert(static_cast<int>(s));
+    return out;
+}
 }  // namespace
 
 TEST_CASE("hierarchy: every segment in one leaf, boxes nest, depth is logarithmic") {
@@ -70,27 +89,16 @@ TEST_CASE("hierarchy: box queries find exactly what a linear scan finds") {
     std::mt19937_64 rng(6);
     const auto segs = random_segments(rng, 3000);
     const Hierarchy h(segs, 2);
-    std::uniform_real_distribution<double> U(0, 1);
     std::vector<int32_t> stack;
     for (int q = 0; q < 50; ++q) {
-        Box query;
-        query.add(Vec2{U(rng), U(rng)});
-        query.add(Vec2{U(rng), U(rng)});
+        const Box query = random_box(rng);
         std::set<int> found;
         const long visited = h.query([&](const Box& b) { return overlap(b, query); },
                                      [&](int s, const Segment& g) {
-                                         Box gb;
-                                         gb.add(g);
-                                         if (overlap(gb, query)) found.insert(s);
+                                         if (box_meets(g, query)) found.insert(s);
                                      },
                                      stack);
-        std::set<int> expected;
-        for (size_t s = 0; s < segs.size(); ++s) {
-            Box gb;
-            gb.add(segs[s]);
-            if (overlap(gb, query)) expected.insert(static_cast<int>(s));
-        }
-        CHECK(found == expected);
+        CHECK(found == linear_scan(segs, query));
         CHECK(visited >= 1);
     }
 }
@@ -140,24 +148,14 @@ TEST_CASE("hierarchy: set_blockers counts per node, and query_blockers walks onl
     }
     std::vector<int32_t> stack;
     for (int q = 0; q < 30; ++q) {
-        Box query;
-        query.add(Vec2{U(rng), U(rng)});
-        query.add(Vec2{U(rng), U(rng)});
+        const Box query = random_box(rng);
         std::set<int> found;
         const long visited = h.query_blockers([&](const Box& b) { return overlap(b, query); },
                                               [&](int s, const Segment& g) {
-                                                  Box gb;
-                                                  gb.add(g);
-                                                  if (overlap(gb, query)) found.insert(s);
+                                                  if (box_meets(g, query)) found.insert(s);
                                               },
                                               stack);
-        std::set<int> expected;
-        for (size_t s = 0; s < segs.size(); ++s) {
-            Box gb;
-            gb.add(segs[s]);
-            if (can[s] && overlap(gb, query)) expected.insert(static_cast<int>(s));
-        }
-        CHECK(found == expected);
+        CHECK(found == linear_scan(segs, query, &can));
         const long all = h.query([&](const Box& b) { return overlap(b, query); }, [](int, const Segment&) {}, stack);
         CHECK(visited <= all);
     }
