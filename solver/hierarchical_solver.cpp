@@ -187,6 +187,7 @@ private:
     void sort_links();
     void apply_G(const Eigen::VectorXd& x, Eigen::VectorXd& out, bool correct, const Part* part = nullptr);
     void build_parts();
+    void clear_scratch(std::vector<double>& per_node, std::vector<double>& tables, const Part* part) const;
     bool in_part(const Part* part, int node, int parent) const {
         return !part || m_part_of[static_cast<size_t>(parent)] == m_part_of[static_cast<size_t>(node)];
     }
@@ -701,22 +702,31 @@ int HierarchicalSolver::split_element(int node) {
 
 // Pull: per node the length-weighted mean of `leaf_value` over element
 // leaves (Bn), per cluster table the exitance I(phi_k).
+// Zeroes a per-node array and the per-table array that goes with it: all
+// of them, or only a part's nodes and their tables (the rest left as it
+// was, so that a small part costs what it holds).
+void HierarchicalSolver::clear_scratch(std::vector<double>& per_node, std::vector<double>& tables,
+                                       const Part* part) const {
+    const size_t N = m_nodes.size();
+    const size_t T = static_cast<size_t>(m_tables_count) * K;
+    if (!part || per_node.size() != N || tables.size() != T) {
+        per_node.assign(N, 0.0);
+        tables.assign(T, 0.0);
+    }
+    if (part)
+        for (int k : part->nodes) {
+            per_node[static_cast<size_t>(k)] = 0;
+            if (m_nodes[static_cast<size_t>(k)].table >= 0)
+                std::fill_n(&tables[static_cast<size_t>(m_nodes[static_cast<size_t>(k)].table) * K], K, 0.0);
+        }
+}
+
 // With a part, only its nodes are zeroed and visited (the rest of Bn and I
 // is left as it was).
 void HierarchicalSolver::pull_tables(const double* leaf_value, std::vector<double>& Bn,
                                      std::vector<double>& I, const Part* part) const {
     const size_t N = m_nodes.size();
-    const size_t T = static_cast<size_t>(m_tables_count) * K;
-    if (!part || Bn.size() != N || I.size() != T) {
-        Bn.assign(N, 0.0);
-        I.assign(T, 0.0);
-    }
-    if (part)
-        for (int k : part->nodes) {
-            Bn[static_cast<size_t>(k)] = 0;
-            if (m_nodes[static_cast<size_t>(k)].table >= 0)
-                std::fill_n(&I[static_cast<size_t>(m_nodes[static_cast<size_t>(k)].table) * K], K, 0.0);
-        }
+    clear_scratch(Bn, I, part);
     const size_t count = part ? part->nodes.size() : N;
     for (size_t q = count; q-- > 0;) {
         const size_t k = part ? static_cast<size_t>(part->nodes[q]) : q;
@@ -1111,19 +1121,8 @@ void HierarchicalSolver::push_down(std::vector<double>& tables, const std::vecto
 // With a part, x and out are still indexed by all element leaves, but only
 // the part's are read and written.
 void HierarchicalSolver::apply_G(const Eigen::VectorXd& x, Eigen::VectorXd& out, bool correct, const Part* part) {
-    const size_t N = m_nodes.size();
-    const size_t T = static_cast<size_t>(m_tables_count) * K;
     pull_tables(x.data(), m_Bn, m_I, part);
-    if (!part || m_Hn.size() != N || m_J.size() != T) {
-        m_Hn.assign(N, 0.0);
-        m_J.assign(T, 0.0);
-    }
-    if (part)
-        for (int k : part->nodes) {
-            m_Hn[static_cast<size_t>(k)] = 0;
-            if (m_nodes[static_cast<size_t>(k)].table >= 0)
-                std::fill_n(&m_J[static_cast<size_t>(m_nodes[static_cast<size_t>(k)].table) * K], K, 0.0);
-        }
+    clear_scratch(m_Hn, m_J, part);
     // Gather, in parallel over receivers.
     const long R = static_cast<long>(part ? part->receivers.size() : m_receivers.size());
 #pragma omp parallel for num_threads(m_threads) schedule(dynamic, 256) if (R > 16 * parallel_min_work)
