@@ -35,10 +35,23 @@
 
 namespace flatrad {
 
+/// Each table also has a linear part, two numbers after the samples (so a
+/// table is directional_table_width doubles): the vector sum_i w_i n_i of
+/// the lobes added to it. Where every member faces a direction u (the
+/// cluster's normal cone, engine/normal_cone.h), the sum of lobes IS that
+/// vector dotted with u, exactly: no interpolation, no kink. A curved wall
+/// seen from along itself (every exchange on a round room's wall) reads
+/// its exitance and sensitivity there; the samples serve the rest.
+/// Arrival tables use the linear part for arrivals every member faces:
+/// each element reads n . (sum of a u), exactly its cosine.
+///
 /// 32 directions: 0.196 rad apart; the smooth-case interpolation error of a
 /// cosine lobe is h^2/8 = 0.5%, and every link with more error than its
 /// share gets refined below the clusters anyway.
 inline constexpr int directional_bins = 32;
+
+/// Samples, then the linear part (x, y).
+inline constexpr int directional_table_width = directional_bins + 2;
 
 /// Where an angle falls in the table: samples k and (k + 1) mod K, weight t
 /// of the second.
@@ -73,16 +86,20 @@ inline const std::array<Vec2, directional_bins>& bin_directions() {
     return dirs;
 }
 
-/// Adds w cos+(n . u(phi_k)) to table[0..K).
+/// Adds the lobe w cos+(n . u) to a table: to its samples (w cos+(n .
+/// u(phi_k))) and to its linear part (w n).
 inline void add_cosine_lobe(double* table, Vec2 n, double w) {
     const auto& d = bin_directions();
     for (int k = 0; k < directional_bins; ++k) {
         const double c = n.x * d[static_cast<size_t>(k)].x + n.y * d[static_cast<size_t>(k)].y;
         if (c > 0) table[k] += w * c;
     }
+    table[directional_bins] += w * n.x;
+    table[directional_bins + 1] += w * n.y;
 }
 
-/// sum_k J_k cos+(n . u(psi_k)): what an element of normal n receives.
+/// What an element of normal n receives from an arrival table: sum_k J_k
+/// cos+(n . u(psi_k)) from the samples, plus n . (linear part).
 inline double read_cosine_lobe(const double* table, Vec2 n) {
     const auto& d = bin_directions();
     double s = 0;
@@ -90,7 +107,18 @@ inline double read_cosine_lobe(const double* table, Vec2 n) {
         const double c = n.x * d[static_cast<size_t>(k)].x + n.y * d[static_cast<size_t>(k)].y;
         if (c > 0) s += table[k] * c;
     }
-    return s;
+    return s + n.x * table[directional_bins] + n.y * table[directional_bins + 1];
+}
+
+/// The linear part read at unit direction u.
+inline double read_linear(const double* table, Vec2 u) {
+    return table[directional_bins] * u.x + table[directional_bins + 1] * u.y;
+}
+
+/// Adds an arrival of weight c from direction u to the linear part.
+inline void add_linear(double* table, Vec2 u, double c) {
+    table[directional_bins] += c * u.x;
+    table[directional_bins + 1] += c * u.y;
 }
 
 inline double interpolate(const double* table, BinWeight b) {

@@ -28,7 +28,12 @@
 ///    tables of 32 directions, read and written by linear interpolation; an
 ///    element under a cluster reads its cosine lobe from J. Each cluster
 ///    also has its sensitivity N(psi) = sum L cos+ (power received per unit
-///    arrival density).
+///    arrival density). Each table also holds its linear part, sum w n:
+///    where every member of a cluster faces every point of the link's other
+///    end (its normal cone, engine/normal_cone.h, against the corners of
+///    the boxes along the segments, engine/oriented_box.h) the link reads
+///    and writes that instead, exactly (a curved wall seen from along
+///    itself); where none faces, the link is dropped.
 ///  - Refinement oracle: a link is split when its estimated error in
 ///    transported power exceeds eps_abs = eps x W / N (W the scene's exitant
 ///    power in the current solution, max over channels; N the patch count:
@@ -41,7 +46,8 @@
 ///    inside a cluster: sensitivity beyond the box's width, min(tau, 1 -
 ///    tau), the visibility bound; and where a table reads 0 at the centres'
 ///    direction, its highest value over the nodes' angular spread: a
-///    grazing lobe); the side with the larger share is split.
+///    grazing lobe; a linear read's own variation over the spread, to
+///    second order); the side with the larger share is split.
 ///    Overlapping nodes (d <= rho_r + rho_s, or an element whose line cuts
 ///    the cluster's box) are always split when they carry light. The first
 ///    round refines against a guess (every patch at E + rho B_bar, B_bar

@@ -4,7 +4,6 @@
 
 namespace flatrad {
 
-
 std::vector<char> visible_sinks(const Scene& scene, const Connectivity& conn) {
     const size_t S = scene.segments.size();
     std::vector<char> visible(2 * S, 0);
@@ -18,7 +17,9 @@ std::vector<char> visible_sinks(const Scene& scene, const Connectivity& conn) {
         bool any_unlit = false;
         for (int s : L.segments) any_unlit = any_unlit || visible[2 * static_cast<size_t>(s)] || visible[2 * static_cast<size_t>(s) + 1];
         if (!any_unlit) continue;
-        const double cost = static_cast<double>(S) * static_cast<double>(L.polygon.size());
+        // Each segment off L costs two point-in-polygon tests and a contact
+        // test, O(|L|) each; segments on L cost nothing.
+        const double cost = static_cast<double>(S - L.segments.size()) * static_cast<double>(L.polygon.size());
         if (cost > budget) continue;
         budget -= cost;
         std::vector<char> on_loop(S, 0);

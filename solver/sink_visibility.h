@@ -18,8 +18,11 @@
 ///    is lit.
 /// Point-in-polygon by crossing number; a point within rounding of L's
 /// boundary counts as touching (then the sink is kept: not proven).
-/// Cost: O(segments x |L|) per loop with unlit sides, skipped (sinks kept)
-/// beyond 1e8 tests in all.
+/// Cost: O((segments off L) x |L|) per loop with unlit sides, skipped
+/// (sinks kept) beyond 1e8 tests in all. A round room of 10^5 walls and
+/// nothing inside costs nothing (it once counted its own walls: 10^10,
+/// over the budget, so its outer sides stayed as sinks and its clusters
+/// faced both ways).
 #include <vector>
 
 #include "engine/connectivity.h"

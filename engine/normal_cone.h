@@ -1,0 +1,81 @@
+#pragma once
+/// The directions a group of surfaces faces: the smallest arc of the circle
+/// of directions holding every member's normal (a "normal cone", in 2D an
+/// angular interval). It tells where a sum of cosine lobes is linear:
+/// sum_i w_i cos+(n_i . u) = (sum_i w_i n_i) . u exactly wherever every
+/// n_i . u >= 0 (faces_all), and is 0 wherever every n_i . u <= 0
+/// (faces_none); both are asked for every direction between two convex
+/// regions given by their corners.
+/// Used by the hierarchical solver's directional model (solver/directional.h).
+#include <array>
+#include <cmath>
+#include <utility>
+#include <numbers>
+
+#include "engine/geometry.h"
+
+namespace flatrad {
+
+struct NormalCone {
+    double lo = 0;      ///< start angle of the arc (radians, [0, 2 pi))
+    double width = -1;  ///< counter-clockwise extent; < 0: empty (no member)
+
+    bool empty() const { return width < 0; }
+
+    static double angle_of(Vec2 n) {
+        double a = std::atan2(n.y, n.x);
+        return a < 0 ? a + 2 * std::numbers::pi : a;
+    }
+    static NormalCone of(Vec2 n) { return {angle_of(n), 0.0}; }
+
+    /// The smallest arc holding both (it starts where one of them starts).
+    static NormalCone merge(const NormalCone& a, const NormalCone& b) {
+        if (a.empty()) return b;
+        if (b.empty()) return a;
+        constexpr double two_pi = 2 * std::numbers::pi;
+        auto ccw = [&](double from, double to) {  // counter-clockwise angle from -> to, in [0, 2 pi)
+            const double d = std::fmod(to - from, two_pi);
+            return d < 0 ? d + two_pi : d;
+        };
+        const double wa = std::max(a.width, ccw(a.lo, b.lo) + b.width);
+        const double wb = std::max(b.width, ccw(b.lo, a.lo) + a.width);
+        NormalCone c = wa <= wb ? NormalCone{a.lo, wa} : NormalCone{b.lo, wb};
+        if (c.width >= two_pi) c = {0.0, two_pi};
+        return c;
+    }
+
+    /// The arc's two end normals (equal for one member).
+    std::pair<Vec2, Vec2> ends() const {
+        return {{std::cos(lo), std::sin(lo)}, {std::cos(lo + width), std::sin(lo + width)}};
+    }
+
+    /// Every member faces (n . (t - f) >= 0) from every point f of the
+    /// convex hull of `from` to every point t of the hull of `to`. Checked
+    /// at the arc's two end normals and the points' differences: the
+    /// condition is linear in n and in t - f, and an arc narrower than pi
+    /// lies in the half circle of any w its two ends are positive on.
+    template <size_t A, size_t B>
+    bool faces_all(const std::array<Vec2, A>& from, const std::array<Vec2, B>& to) const {
+        return !empty() && width < std::numbers::pi && all_signed(from, to, 1.0);
+    }
+    /// No member faces any point of `to` from any point of `from` (an empty
+    /// cone faces nothing).
+    template <size_t A, size_t B>
+    bool faces_none(const std::array<Vec2, A>& from, const std::array<Vec2, B>& to) const {
+        return empty() || (width < std::numbers::pi && all_signed(from, to, -1.0));
+    }
+
+private:
+    template <size_t A, size_t B>
+    bool all_signed(const std::array<Vec2, A>& from, const std::array<Vec2, B>& to, double sign) const {
+        const auto [n0, n1] = ends();
+        for (const Vec2 f : from)
+            for (const Vec2 t : to) {
+                const Vec2 w = t - f;
+                if (!(sign * dot(n0, w) >= 0 && sign * dot(n1, w) >= 0)) return false;
+            }
+        return true;
+    }
+};
+
+}  // namespace flatrad
