@@ -88,9 +88,11 @@ constexpr const char* usage_text =
     "         two-sided plates (1840 patches). Defaults: R 3, L 0.025, S 1;\n"
     "         --sweep-lengths adds plate lengths 0.01 and 0.05.\n"
     "  scale  [--sizes N,...] [--eps E] [--vis-eps V] [--repeat R] [--density D] [--lamps L]\n"
-    "         [--seed S] [--timeout SEC] [--max-memory MIB] [--threads T] [--keep-going]\n"
+    "         [--seed S] [--timeout SEC] [--max-memory MIB] [--threads T] [--keep-going] [--round]\n"
     "         `flatrad solve --method hierarchical` (child process) on forests of N segments made by\n"
-    "         `scripts/make-scene N --seed S --density D --lamps L` (cached in <build>/bench-scenes):\n"
+    "         `scripts/make-scene N --seed S --density D --lamps L` (cached in <build>/bench-scenes),\n"
+    "         or with --round on round rooms of N walls, L of them lamps (`make-scene N --round\n"
+    "         --lamps L`: nothing can block, so it measures clustering without visibility):\n"
     "         load, solve and wall time, elements, links, iterations, peak RSS, time / (N log2 N)\n"
     "         and the empirical exponent. A run is killed after SEC seconds (reported as timed out;\n"
     "         larger sizes are then skipped unless --keep-going); memory limited to MIB (RLIMIT_DATA,\n"
@@ -851,6 +853,7 @@ struct ForestSpec {
     double density = 30;  // data/forest.json: 3000 blockers in 10 x 10
     int lamps = 1;
     long seed = 1;
+    bool round = false;   // `make-scene N --round --lamps L` instead (density and seed unused)
 };
 
 struct CachedScene {
@@ -860,6 +863,7 @@ struct CachedScene {
 
 // The cache's name for it (scale and versus share a scene of the same arguments).
 std::string forest_stem(const ForestSpec& f) {
+    if (f.round) return fmt::format("round-N{}-L{}", f.segments, f.lamps);
     return fmt::format("forest-N{}-D{}-L{}-S{}", f.segments, f.density, f.lamps, f.seed);
 }
 
@@ -874,9 +878,10 @@ CachedScene forest_scene(const std::string& stem, const ForestSpec& f) {
                                              script.string()));
     const std::filesystem::path dir = scene_cache_dir();
     std::filesystem::create_directories(dir);
-    const std::vector<std::string> args{script.string(), std::to_string(f.segments), "--seed", std::to_string(f.seed),
-                                        "--density",      fmt::format("{}", f.density), "--lamps",
-                                        std::to_string(f.lamps)};
+    std::vector<std::string> args{script.string(), std::to_string(f.segments), "--seed", std::to_string(f.seed),
+                                  "--density",      fmt::format("{}", f.density), "--lamps",
+                                  std::to_string(f.lamps)};
+    if (f.round) args = {script.string(), std::to_string(f.segments), "--round", "--lamps", std::to_string(f.lamps)};
     std::string key;
     for (const std::string& a : args) {
         if (!key.empty()) key += ' ';
@@ -954,6 +959,7 @@ struct ScaleOptions {
     long max_memory_mib = 8192;
     int threads = 0;
     bool keep_going = false;
+    bool round = false;  // round rooms instead of forests
 };
 
 struct ScaleRow {
@@ -978,6 +984,11 @@ void run_scale(ScaleOptions o, const std::string& cmd) {
     fmt::print("command: {}\n", cmd);
     fmt::print("program: {} (copied at start, so that a rebuild cannot change it mid-run)\n",
                (program_dir() / "flatrad").string());
+    if (o.round)
+        fmt::print("scene: `scripts/make-scene N --round --lamps {}`: a round room of radius 1, N walls (lit in,\n"
+                   "       reflectance 0.7) in one closed loop, {} of them lamps; nothing can block; cached in {}.\n",
+                   o.lamps, o.lamps, scene_cache_dir().string());
+    else
     fmt::print("scene: `scripts/make-scene N --seed {} --density {} --lamps {}`: a square room (4 segments, lit in,\n"
                "       reflectance 0.7) of side sqrt(B / {}), {} ceiling lamp(s) and B = N - {} two-sided blockers\n"
                "       of length 0.05-0.15 (reflectance 0.3), so the density, not the room, stays the same;\n"
@@ -1008,7 +1019,7 @@ void run_scale(ScaleOptions o, const std::string& cmd) {
         }
         CachedScene scene;
         try {
-            const ForestSpec spec{N, o.density, o.lamps, o.seed};
+            const ForestSpec spec{N, o.density, o.lamps, o.seed, o.round};
             scene = forest_scene(forest_stem(spec), spec);
         } catch (const std::exception& e) {
             row.failure = e.what();
@@ -1292,10 +1303,11 @@ int run(int argc, char** argv) {
             parse_options(argc, argv,
                           {"--sizes", "--eps", "--vis-eps", "--repeat", "--density", "--lamps", "--seed", "--timeout",
                            "--max-memory", "--threads"},
-                          {"--keep-going"});
+                          {"--keep-going", "--round"});
         ScaleOptions o;
+        o.round = opt.flags.count("--round") > 0;
         if (auto v = opt.get("--lamps")) o.lamps = static_cast<int>(parse_long(*v, "--lamps", 1));
-        if (auto v = opt.get("--sizes")) o.sizes = parse_list(*v, "--sizes", 4 + o.lamps);
+        if (auto v = opt.get("--sizes")) o.sizes = parse_list(*v, "--sizes", o.round ? std::max(3, 2 * o.lamps) : 4 + o.lamps);
         if (auto v = opt.get("--eps")) o.eps = parse_positive(*v, "--eps");
         if (auto v = opt.get("--vis-eps")) o.vis_eps = parse_positive(*v, "--vis-eps");
         if (auto v = opt.get("--repeat")) o.repeat = static_cast<int>(parse_long(*v, "--repeat", 1));

@@ -262,6 +262,7 @@ private:
     VisibilityStats m_stats;
     double m_ff_time = 0, m_solve_time = 0, m_residual = 0;
     long m_iterations = 0;
+    bool m_solved = false;  // m_B holds a solution (the next Krylov run starts from it)
     long m_cluster_links = 0;
 };
 
@@ -1261,6 +1262,14 @@ void HierarchicalSolver::solve() {
     reach();
     sort_links();
     build_parts();
+    // Krylov runs start from the previous round's solution (a new half
+    // from the element it halves): a refinement round changes few links,
+    // so the next solve has little left to do. The first starts from E.
+    // (split_element gives halves their parent's values.)
+    const std::vector<std::vector<double>> previous = std::move(m_B);
+    auto start_value = [&](int c, int node) {
+        return m_solved ? previous[static_cast<size_t>(c)][static_cast<size_t>(node)] : emission(node, c);
+    };
     m_B.assign(static_cast<size_t>(m_C), std::vector<double>(m_nodes.size(), 0.0));
     m_H = m_B;
     for (int c = 0; c < m_C; ++c) {
@@ -1283,7 +1292,7 @@ void HierarchicalSolver::solve() {
             Eigen::VectorXd Ep(m), xp(m);
             for (Eigen::Index j = 0; j < m; ++j) {
                 Ep(j) = E(part.leaves[static_cast<size_t>(j)]);
-                xp(j) = Ep(j);
+                xp(j) = start_value(c, m_leaves[static_cast<size_t>(part.leaves[static_cast<size_t>(j)])]);
             }
             auto apply = [&](const Eigen::VectorXd& v) -> Eigen::VectorXd {
                 for (Eigen::Index j = 0; j < m; ++j) full(part.leaves[static_cast<size_t>(j)]) = v(j);
@@ -1319,6 +1328,7 @@ void HierarchicalSolver::solve() {
         for (Eigen::Index i = 0; i < n; ++i) H[static_cast<size_t>(m_leaves[static_cast<size_t>(i)])] = g(i);
         progress(fmt::format("solved channel {} of {}", c + 1, m_C), -1);
     }
+    m_solved = true;
     m_solve_time += seconds_since(t0);
 }
 
