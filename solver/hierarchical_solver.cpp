@@ -104,6 +104,9 @@ struct Link {
     float Fu = 0;             // element links: unoccluded F
     bool unresolved = false;  // cluster links whose nodes overlap: must be split if they carry light
     bool clear = false;       // element links whose shaft held no blocker: nor do their children's
+    // Cluster links: transmittance not asked yet (coef unoccluded). The
+    // refinement asks only if the link is not split on its geometry alone.
+    bool vis_pending = false;
     // Cluster ends read through the table's linear part (directional.h):
     // every member faces every direction the link can take.
     bool s_linear = false, r_linear = false;
@@ -186,12 +189,14 @@ private:
     void children_links(const Link& l, bool split_r, std::vector<Link>& out) const;
     void self_links(int node, std::vector<Link>& out) const;
     bool make_link(int r, int s, Link& l, ExactWorkspace& ws, VisibilityStats& st) const;
+    bool resolve_visibility(Link& l, ExactWorkspace& ws, VisibilityStats& st) const;
     std::pair<double, double> link_transmittance(int r, int s, ExactWorkspace& ws, VisibilityStats& st) const;
     void compute_links(std::vector<Link>& links);
     int split_element(int node);
     void pull_tables(const double* leaf_value, std::vector<double>& Bn, std::vector<double>& I,
                      const Part* part = nullptr) const;
-    LinkError link_error(const Link& l, const std::vector<double>& Bn, const std::vector<double>& I) const;
+    LinkError link_error(const Link& l, const std::vector<double>& Bn, const std::vector<double>& I,
+                         bool geometry_only = false) const;
     bool refine(const std::vector<double>& leaf_bmax);
     void collect_leaves();
     void reach();
@@ -625,16 +630,30 @@ bool HierarchicalSolver::make_link(int r, int s, Link& l, ExactWorkspace& ws, Vi
     } else {
         coef_u = 1 / dist;
     }
-    double tau = 1, terr = 0;
-    if (!m_unblockable) {
-        std::tie(tau, terr) = link_transmittance(r, s, ws, st);
-    } else {
+    l.coef = coef_u;
+    if (m_unblockable) {
         ++st.unoccluded;
+        return true;
     }
-    if (!(tau > 0) && terr == 0) return false;
+    // The transmittance is asked later, and only if the link survives its
+    // geometry (refine; resolve_visibility).
+    l.vis_pending = true;
+    return true;
+}
+
+// Asks the visibility module for a pending cluster link's transmittance;
+// false when nothing passes (the link is to be dropped).
+bool HierarchicalSolver::resolve_visibility(Link& l, ExactWorkspace& ws, VisibilityStats& st) const {
+    const auto [tau, terr] = link_transmittance(l.r, l.s, ws, st);
+    l.vis_pending = false;
+    if (!(tau > 0) && terr == 0) {
+        l.coef = 0;
+        l.tau = 0;
+        return false;
+    }
     l.tau = static_cast<float>(tau);
     l.vis_err = static_cast<float>(terr);
-    l.coef = tau * coef_u;
+    l.coef *= tau;
     return true;
 }
 
@@ -800,8 +819,8 @@ void HierarchicalSolver::pull_tables(const double* leaf_value, std::vector<doubl
 // Estimated error in the power the link transports, with the sender values
 // of the current solution (Bn per node, I per cluster table), and which
 // side's approximations make most of it (split_r: the receiver's).
-LinkError HierarchicalSolver::link_error(const Link& l, const std::vector<double>& Bn,
-                                         const std::vector<double>& I) const {
+LinkError HierarchicalSolver::link_error(const Link& l, const std::vector<double>& Bn, const std::vector<double>& I,
+                                         bool geometry_only) const {
     const Node& r = m_nodes[static_cast<size_t>(l.r)];
     const Node& s = m_nodes[static_cast<size_t>(l.s)];
     constexpr double inf = std::numeric_limits<double>::infinity();
@@ -948,6 +967,10 @@ LinkError HierarchicalSolver::link_error(const Link& l, const std::vector<double
         rel_s = 2 * s.radius / dist + layered(s, l.sbin) + v_err / v;
     else
         rel_s = 2 * s.radius / dist;
+    // The part no transmittance changes (unocc and the relative terms do
+    // not depend on tau): a lower bound of the error below, for a link
+    // whose transmittance is not known yet.
+    if (geometry_only) return {unocc * (rel_r + rel_s), rel_r >= rel_s};
     // Visibility: a partly hidden link may put a shadow boundary anywhere,
     // and the transmittance is known to its bound. Splitting the larger
     // side narrows the shaft most.
@@ -1010,31 +1033,64 @@ bool HierarchicalSolver::refine(const std::vector<double>& leaf_bmax) {
     std::vector<char> dead(m_links.size(), 0);
     while (!work.empty()) {
         // 1. Decide, in parallel.
+        // A cluster link whose transmittance is pending is split on its
+        // geometry alone when that exceeds eps_abs (a lower bound of its
+        // error whatever tau is); only the others ask the visibility module
+        // (most cluster links of an occluded scene are split anyway).
         decision.assign(work.size(), 0);
         const long nw = static_cast<long>(work.size());
-#pragma omp parallel for num_threads(m_threads) schedule(dynamic, 64) if (nw > 16 * parallel_min_work)
-        for (long k = 0; k < nw; ++k) {
-            const Link& l = m_links[static_cast<size_t>(work[static_cast<size_t>(k)])];
-            const Node& r = m_nodes[static_cast<size_t>(l.r)];
-            const Node& s = m_nodes[static_cast<size_t>(l.s)];
-            if (l.r == l.s) {
-                decision[static_cast<size_t>(k)] = 3;
-                continue;
+        const auto t_decide = Clock::now();
+        long resolved = 0;
+#pragma omp parallel num_threads(m_threads) if (nw > 16 * parallel_min_work)
+        {
+            ExactWorkspace ws;
+            VisibilityStats local;
+            long asked = 0;
+#pragma omp for schedule(dynamic, 64)
+            for (long k = 0; k < nw; ++k) {
+                Link& l = m_links[static_cast<size_t>(work[static_cast<size_t>(k)])];
+                const Node& r = m_nodes[static_cast<size_t>(l.r)];
+                const Node& s = m_nodes[static_cast<size_t>(l.s)];
+                if (l.r == l.s) {
+                    decision[static_cast<size_t>(k)] = 3;
+                    continue;
+                }
+                const bool can_r = r.cluster() || (r.kind == Kind::Element && r.depth < m_opt.max_depth);
+                const bool can_s = s.cluster() || (s.kind == Kind::Element && s.depth < m_opt.max_depth);
+                if (l.vis_pending) {
+                    if (can_r || can_s) {
+                        const LinkError g = link_error(l, Bn, I, true);
+                        if (g.err > eps_abs) {
+                            decision[static_cast<size_t>(k)] = can_r && (!can_s || g.split_r) ? 1 : 2;
+                            continue;
+                        }
+                    }
+                    ++asked;
+                    if (!resolve_visibility(l, ws, local)) {
+                        decision[static_cast<size_t>(k)] = 4;  // nothing passes: dropped
+                        continue;
+                    }
+                }
+                if (!can_r && !can_s) continue;
+                const LinkError e = link_error(l, Bn, I);
+                if (e.err <= eps_abs) continue;
+                const bool split_r = can_r && (!can_s || e.split_r);
+                decision[static_cast<size_t>(k)] = split_r ? 1 : 2;
             }
-            const bool can_r = r.cluster() || (r.kind == Kind::Element && r.depth < m_opt.max_depth);
-            const bool can_s = s.cluster() || (s.kind == Kind::Element && s.depth < m_opt.max_depth);
-            if (!can_r && !can_s) continue;
-            const LinkError e = link_error(l, Bn, I);
-            if (e.err <= eps_abs) continue;
-            const bool split_r = can_r && (!can_s || e.split_r);
-            decision[static_cast<size_t>(k)] = split_r ? 1 : 2;
+#pragma omp critical
+            {
+                m_stats += local;
+                resolved += asked;
+            }
         }
+        if (resolved > 0) m_ff_time += seconds_since(t_decide);
         // 2. Split (serially: creates nodes), collecting the children links.
         std::vector<Link> fresh;
         for (size_t k = 0; k < work.size(); ++k) {
             if (!decision[k]) continue;
             const Link l = m_links[static_cast<size_t>(work[k])];
             dead[static_cast<size_t>(work[k])] = 1;
+            if (decision[k] == 4) continue;  // dropped, not split
             any = true;
             if (decision[k] == 3) {
                 self_links(l.r, fresh);
@@ -1080,6 +1136,8 @@ void HierarchicalSolver::collect_leaves() {
 // Groups links by receiver (CSR) so that the gather runs in parallel over
 // receivers without races.
 void HierarchicalSolver::sort_links() {
+    for ([[maybe_unused]] const Link& l : m_links)
+        FLATRAD_ASSERT(!l.vis_pending, "a link reached the solve without its transmittance");
     // Counting sort by receiver (stable: a receiver's links keep their
     // order, which is deterministic): O(links + nodes), where a comparison
     // sort of tens of millions of links took a tenth of a large solve.

@@ -47,7 +47,11 @@
 ///    tau), the visibility bound; and where a table reads 0 at the centres'
 ///    direction, its highest value over the nodes' angular spread: a
 ///    grazing lobe; a linear read's own variation over the spread, to
-///    second order); the side with the larger share is split.
+///    second order); the side with the larger share is split. A cluster
+///    link's transmittance is asked only when its geometric terms alone
+///    (which no tau changes) do not already exceed eps_abs: most cluster
+///    links of an occluded scene are split on geometry, and their queries
+///    were most of its time (a 1000-segment forest: 59 s -> 20 s).
 ///    Overlapping nodes (d <= rho_r + rho_s, or an element whose line cuts
 ///    the cluster's box) are always split when they carry light. The first
 ///    round refines against a guess (every patch at E + rho B_bar, B_bar
