@@ -43,6 +43,18 @@ constexpr int TW = directional_table_width;  // samples, then the linear part
 // on one thread; decisions and gathers (~1 us each) need 16x more.
 constexpr long parallel_min_work = 64;
 
+// Multi-scale visibility approximates clusters only in shafts holding at
+// least this many blocker pieces: below it, the criterion's set-up and the
+// direction integral cost more than the exact sweep they would replace.
+// Measured (eps 0.5, the 1000-segment forest of `scripts/bench versus`):
+// approximating wherever the criterion allowed took 16.3 s, from 32 pieces
+// on 15.9 s, from 128 on 13.7 s, from 512 on 8.8 s, and exact visibility
+// everywhere (--vis-eps 0) 8.5 s; on data/forest.json (3005 segments, the
+// default eps) 274 s against 193 s exact. The exact sweep grows as the
+// square of the pieces (1000 pieces: 0.2 s a query, `scripts/bench
+// ffcost`), so very crowded shafts are left to the approximation.
+constexpr size_t min_pieces_to_approximate = 512;
+
 // GMRES stops at ||E - (I - rho G) B|| <= 1e-12 ||E||: the operator is
 // applied in double with sums of at most a few thousand terms per node, so
 // 1e-12 is reachable and keeps B to ~1e-9 relative even where
@@ -147,6 +159,7 @@ public:
           m_obox(oriented_boxes(m_hierarchy)) {
         m_threads = o.threads > 0 ? o.threads : omp_get_max_threads();
         m_vis_eps = o.vis_eps >= 0 ? o.vis_eps : o.eps / 10;
+        m_vis.set_min_pieces_to_approximate(min_pieces_to_approximate);
 
         // Walls on the scene's hull block nothing (engine/convex_scene.h):
         // visibility skips them; with no blocker at all it is never asked.

@@ -11,7 +11,9 @@
 ///    is split into its children's pairs and self links, and so on; a link
 ///    to a hierarchy leaf goes to its sides. A link (receiver r, sender s):
 ///      element <- element: F_rs, the exact average over r, from
-///        MultiscaleVisibility with --vis-eps (absolute on F);
+///        MultiscaleVisibility with --vis-eps (absolute on F; clusters are
+///        approximated only in shafts of 512 blocker pieces or more, where
+///        that is cheaper than the exact sweep: see the .cpp);
 ///      anything <- cluster, cluster <- element: point approximations at
 ///        the nodes' centres, times a transmittance from the visibility
 ///        module (MultiscaleVisibility::transmittance, --vis-eps on tau):

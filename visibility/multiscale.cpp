@@ -744,6 +744,7 @@ MultiscaleResult MultiscaleVisibility::form_factor_skipping(const Segment& i, co
     if (!separated) {
         // 1b. Decide, top down: approximate a cluster wholly inside the shaft
         //     whose criterion is below eps; the pieces of the rest are exact.
+        if (pieces.size() < m_min_pieces) eps = 0;  // cheaper exact (set_min_pieces_to_approximate)
         const Interactions inter(g, pieces, piece_pos, eps > 0 && rule == GammaRule::Bound && !pieces.empty());
         stack.push_back(m_hierarchy->root());
         while (!stack.empty()) {

@@ -122,6 +122,15 @@ public:
 
     const ClusterTables& tables() const { return *m_tables; }
 
+    /// Approximate nothing in a shaft holding fewer than `n` blocker pieces:
+    /// the answer is then the exact one (within any eps), and costs what the
+    /// exact walk costs. 0 (the default) considers every shaft. A cost
+    /// choice, not an accuracy one: the criterion and the direction integral
+    /// of an approximated shaft cost more than the exact sweep of a few
+    /// hundred pieces (measured on the solver's scenes; see
+    /// solver/hierarchical_solver.cpp, where it is set).
+    void set_min_pieces_to_approximate(size_t n) { m_min_pieces = n; }
+
 private:
     std::optional<TransmittanceResult> transmittance_between(const Segment& sa, const Segment& sb, int skip_a,
                                                              int skip_b, double eps, GammaRule rule,
@@ -137,6 +146,7 @@ private:
     const Hierarchy* m_hierarchy;
     const ClusterTables* m_tables;
     std::vector<int32_t> m_position;  // segment number -> index in hierarchy order
+    size_t m_min_pieces = 0;
 };
 
 }  // namespace flatrad

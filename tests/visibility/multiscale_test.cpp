@@ -185,3 +185,35 @@ TEST_CASE("multiscale: transmittance from a segment is the exact occluded share 
     CHECK(away.tau == 1);
     CHECK(away.error_bound == 1);
 }
+
+TEST_CASE("multiscale: below the piece threshold nothing is approximated and F is exact") {
+    // set_min_pieces_to_approximate is a cost choice: a shaft with fewer
+    // blocker pieces gets the exact answer (bound 0); at or above it the
+    // criterion decides as before. Clouds of a few dozen blockers: a
+    // threshold of 10^6 covers every shaft, 0 none.
+    std::mt19937_64 rng(29);
+    int was_approximated = 0;
+    for (int t = 0; t < 60; ++t) {
+        const test::Cloud c = test::make_cloud(rng);
+        const Hierarchy h(c.segments);
+        const ClusterTables tables(h);
+        MultiscaleVisibility ms(h, tables);
+        const ExactVisibility ex(h);
+        ExactWorkspace ws;
+        VisibilityStats st;
+        const double exact = ex.form_factor(c.i, c.j, 0, 1, ws, st);
+        const MultiscaleResult loose = ms.form_factor(c.i, c.j, 0, 1, 0.1, GammaRule::Bound, ws, st);
+        if (loose.clusters_approximated > 0) ++was_approximated;
+        ms.set_min_pieces_to_approximate(1000000);
+        const MultiscaleResult r = ms.form_factor(c.i, c.j, 0, 1, 0.1, GammaRule::Bound, ws, st);
+        CAPTURE(t);
+        CHECK(r.clusters_approximated == 0);
+        CHECK(r.error_bound == 0);
+        CHECK(std::abs(r.F - exact) <= exact_tol * std::max(exact, 1e-300));
+        // Back to 0: the same approximations as before.
+        ms.set_min_pieces_to_approximate(0);
+        CHECK(ms.form_factor(c.i, c.j, 0, 1, 0.1, GammaRule::Bound, ws, st).clusters_approximated ==
+              loose.clusters_approximated);
+    }
+    CHECK(was_approximated > 10);  // the threshold had something to turn off
+}
