@@ -39,8 +39,9 @@ namespace {
 constexpr int K = directional_bins;
 constexpr int TW = directional_table_width;  // samples, then the linear part
 
-// Below this many links (each a visibility query, up to ~1 ms) a batch runs
-// on one thread; decisions and gathers (~1 us each) need 16x more.
+// Below this many links (each maybe a visibility query, up to ~1 ms: the
+// refinement's decisions) a batch runs on one thread; geometry and gathers
+// (~1 us each) need 16x more.
 constexpr long parallel_min_work = 64;
 
 // Multi-scale visibility approximates clusters only in shafts holding at
@@ -201,7 +202,7 @@ private:
     void endpoints(int node, std::vector<int>& out) const;
     void children_links(const Link& l, bool split_r, std::vector<Link>& out) const;
     void self_links(int node, std::vector<Link>& out) const;
-    bool make_link(int r, int s, Link& l, ExactWorkspace& ws, VisibilityStats& st) const;
+    bool make_link(int r, int s, Link& l, VisibilityStats& st) const;
     bool resolve_visibility(Link& l, ExactWorkspace& ws, VisibilityStats& st) const;
     std::pair<double, double> link_transmittance(int r, int s, ExactWorkspace& ws, VisibilityStats& st) const;
     void compute_links(std::vector<Link>& links);
@@ -542,7 +543,7 @@ void HierarchicalSolver::children_links(const Link& l, bool split_r, std::vector
 }
 
 // Fills l's coefficient and estimates; false when r and s cannot exchange.
-bool HierarchicalSolver::make_link(int r, int s, Link& l, ExactWorkspace& ws, VisibilityStats& st) const {
+bool HierarchicalSolver::make_link(int r, int s, Link& l, VisibilityStats& st) const {
     const Node& nr = m_nodes[static_cast<size_t>(r)];
     const Node& ns = m_nodes[static_cast<size_t>(s)];
     if (r == s) return true;  // a cluster's self link: always split, carries nothing itself
@@ -556,22 +557,15 @@ bool HierarchicalSolver::make_link(int r, int s, Link& l, ExactWorkspace& ws, Vi
             ++st.culled;
             return false;
         }
-        double F = Fu, err = 0;
-        if (!m_unblockable && !l.clear) {
-            const MultiscaleResult m = m_vis.form_factor(nr.seg, ns.seg, nr.segment, ns.segment, m_vis_eps,
-                                                         GammaRule::Bound, ws, st);
-            F = m.F;
-            err = m.error_bound;
-            // Nothing in the shaft (rounding aside: 4 ulps of F).
-            l.clear = err == 0 && std::abs(F - Fu) <= 4 * std::numeric_limits<double>::epsilon() * Fu;
-        } else {
-            ++st.unoccluded;
-        }
-        if (!(F > 0) && err == 0) return false;
-        l.coef = F;
+        l.coef = Fu;
         l.Fu = static_cast<float>(Fu);
-        l.tau = static_cast<float>(F / Fu);
-        l.vis_err = static_cast<float>(err);
+        if (!m_unblockable && !l.clear) {
+            // Visibility is asked later, if the link survives its geometry
+            // (refine; resolve_visibility).
+            l.vis_pending = true;
+            return true;
+        }
+        ++st.unoccluded;
         return true;
     }
     // Cluster links: point approximations at the centres.
@@ -657,8 +651,25 @@ bool HierarchicalSolver::make_link(int r, int s, Link& l, ExactWorkspace& ws, Vi
 // Asks the visibility module for a pending cluster link's transmittance;
 // false when nothing passes (the link is to be dropped).
 bool HierarchicalSolver::resolve_visibility(Link& l, ExactWorkspace& ws, VisibilityStats& st) const {
-    const auto [tau, terr] = link_transmittance(l.r, l.s, ws, st);
+    const Node& nr = m_nodes[static_cast<size_t>(l.r)];
+    const Node& ns = m_nodes[static_cast<size_t>(l.s)];
     l.vis_pending = false;
+    if (!nr.cluster() && !ns.cluster()) {
+        const double Fu = l.coef;
+        const MultiscaleResult m = m_vis.form_factor(nr.seg, ns.seg, nr.segment, ns.segment, m_vis_eps,
+                                                     GammaRule::Bound, ws, st);
+        // Nothing in the shaft (rounding aside: 4 ulps of F): nor in its halves'.
+        l.clear = m.error_bound == 0 && std::abs(m.F - Fu) <= 4 * std::numeric_limits<double>::epsilon() * Fu;
+        if (!(m.F > 0) && m.error_bound == 0) {
+            l.coef = 0;
+            return false;
+        }
+        l.coef = m.F;
+        l.tau = static_cast<float>(m.F / Fu);
+        l.vis_err = static_cast<float>(m.error_bound);
+        return true;
+    }
+    const auto [tau, terr] = link_transmittance(l.r, l.s, ws, st);
     if (!(tau > 0) && terr == 0) {
         l.coef = 0;
         l.tau = 0;
@@ -723,16 +734,16 @@ void HierarchicalSolver::compute_links(std::vector<Link>& links) {
     const auto t0 = Clock::now();
     const long n = static_cast<long>(links.size());
     std::vector<char> keep(links.size(), 1);
-    // Small batches run on one thread: waking the team costs more than
-    // they do (and much more on a loaded machine).
-#pragma omp parallel num_threads(m_threads) if (n > parallel_min_work)
+    // Geometry only (visibility is asked in refine's decisions), ~1 us a
+    // link: small batches run on one thread, waking the team costs more
+    // than they do (and much more on a loaded machine).
+#pragma omp parallel num_threads(m_threads) if (n > 16 * parallel_min_work)
     {
-        ExactWorkspace ws;
         VisibilityStats local;
 #pragma omp for schedule(dynamic, 16)
         for (long k = 0; k < n; ++k) {
             Link& l = links[static_cast<size_t>(k)];
-            keep[static_cast<size_t>(k)] = make_link(l.r, l.s, l, ws, local) ? 1 : 0;
+            keep[static_cast<size_t>(k)] = make_link(l.r, l.s, l, local) ? 1 : 0;
         }
 #pragma omp critical
         m_stats += local;
@@ -854,6 +865,8 @@ LinkError HierarchicalSolver::link_error(const Link& l, const std::vector<double
                 rv += 0.25 * std::abs(form_factor_unoccluded(rq, s.seg) - l.Fu);
             }
         }
+        // Geometry alone (visibility not asked yet): a lower bound.
+        if (geometry_only) return {power * std::max(rv, sv), size_r >= size_s};
         // A partly hidden sender may put a shadow boundary anywhere on the
         // receiver; a sink absorbs all it gets, wherever on it, so there
         // only the accuracy of F itself counts.
@@ -1054,7 +1067,7 @@ bool HierarchicalSolver::refine(const std::vector<double>& leaf_bmax) {
         const long nw = static_cast<long>(work.size());
         const auto t_decide = Clock::now();
         long resolved = 0;
-#pragma omp parallel num_threads(m_threads) if (nw > 16 * parallel_min_work)
+#pragma omp parallel num_threads(m_threads) if (nw > parallel_min_work)
         {
             ExactWorkspace ws;
             VisibilityStats local;
