@@ -88,8 +88,8 @@
 ///    lose is the transport's own energy error: balance = |emitted -
 ///    absorbed - escaped| / emitted measures it (in a scene with no
 ///    escape-free patch, balance only checks the linear solve).
-///    Measured on data/default.json: 2.8e-3 at eps 1e-2, 1.2e-3 at 3e-3,
-///    4.0e-4 at 1e-3, 7.5e-5 at 1e-4, 3.8e-5 at 3e-5.
+///    Measured on data/default.json: 2.3e-3 at eps 1e-2, 1.2e-3 at 3e-3,
+///    4.2e-4 at 1e-3, 7.5e-5 at 1e-4, 3.7e-5 at 3e-5.
 ///  - Refuses (InputError) a closed set of reflectance-1 patches without
 ///    absorber, as solve_exact does.
 #include <functional>
