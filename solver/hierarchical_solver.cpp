@@ -115,6 +115,7 @@ struct Link {
     float vis_err = 0;        // visibility bound: on tau (cluster links) or on F (element links)
     float ux = 0, uy = 0;     // cluster links: unit direction from s's centre to r's
     float Fu = 0;             // element links: unoccluded F
+    float kvar = 0;           // element links: the kernel's variation over quarters (kernel_variation)
     bool unresolved = false;  // cluster links whose nodes overlap: must be split if they carry light
     bool clear = false;       // element links whose shaft held no blocker: nor do their children's
     // Cluster links: transmittance not asked yet (coef unoccluded). The
@@ -204,6 +205,7 @@ private:
     void self_links(int node, std::vector<Link>& out) const;
     bool make_link(int r, int s, Link& l, VisibilityStats& st) const;
     bool resolve_visibility(Link& l, ExactWorkspace& ws, VisibilityStats& st) const;
+    double kernel_variation(const Node& r, const Node& s, double Fu) const;
     std::pair<double, double> link_transmittance(int r, int s, ExactWorkspace& ws, VisibilityStats& st) const;
     void compute_links(std::vector<Link>& links);
     int split_element(int node);
@@ -559,6 +561,7 @@ bool HierarchicalSolver::make_link(int r, int s, Link& l, VisibilityStats& st) c
         }
         l.coef = Fu;
         l.Fu = static_cast<float>(Fu);
+        l.kvar = static_cast<float>(kernel_variation(nr, ns, l.Fu));
         if (!m_unblockable && !l.clear) {
             // Visibility is asked later, if the link survives its geometry
             // (refine; resolve_visibility).
@@ -646,6 +649,24 @@ bool HierarchicalSolver::make_link(int r, int s, Link& l, VisibilityStats& st) c
     // geometry (refine; resolve_visibility).
     l.vis_pending = true;
     return true;
+}
+
+// The unoccluded kernel's variation over quarters of each side of an
+// element link (relative to its F_u): catches ends-vs-middle variation
+// that halves miss by symmetry. A sink receiver's own variation does not
+// count (it absorbs all it gets, wherever on it). Eight crossed strings:
+// computed once per link, not at every refinement round.
+double HierarchicalSolver::kernel_variation(const Node& r, const Node& s, double Fu) const {
+    double rv = 0, sv = 0;
+    for (int q = 0; q < 4; ++q) {
+        const Segment sq{lerp(s.seg.a, s.seg.b, q / 4.0), lerp(s.seg.a, s.seg.b, (q + 1) / 4.0)};
+        sv += std::abs(form_factor_unoccluded(r.seg, sq) - 0.25 * Fu);
+        if (!r.sink()) {
+            const Segment rq{lerp(r.seg.a, r.seg.b, q / 4.0), lerp(r.seg.a, r.seg.b, (q + 1) / 4.0)};
+            rv += 0.25 * std::abs(form_factor_unoccluded(rq, s.seg) - Fu);
+        }
+    }
+    return std::max(rv, sv);
 }
 
 // Asks the visibility module for a pending cluster link's transmittance;
@@ -856,22 +877,15 @@ LinkError HierarchicalSolver::link_error(const Link& l, const std::vector<double
         if (!(power > 0)) return {};
         // Kernel variation over quarters of each side: catches ends-vs-
         // middle variation that halves miss by symmetry.
-        double rv = 0, sv = 0;
-        for (int q = 0; q < 4; ++q) {
-            const Segment sq{lerp(s.seg.a, s.seg.b, q / 4.0), lerp(s.seg.a, s.seg.b, (q + 1) / 4.0)};
-            sv += std::abs(form_factor_unoccluded(r.seg, sq) - 0.25 * l.Fu);
-            if (!r.sink()) {
-                const Segment rq{lerp(r.seg.a, r.seg.b, q / 4.0), lerp(r.seg.a, r.seg.b, (q + 1) / 4.0)};
-                rv += 0.25 * std::abs(form_factor_unoccluded(rq, s.seg) - l.Fu);
-            }
-        }
+        // (computed once, with the link: kernel_variation).
+        const double kvar = l.kvar;
         // Geometry alone (visibility not asked yet): a lower bound.
-        if (geometry_only) return {power * std::max(rv, sv), size_r >= size_s};
+        if (geometry_only) return {power * kvar, size_r >= size_s};
         // A partly hidden sender may put a shadow boundary anywhere on the
         // receiver; a sink absorbs all it gets, wherever on it, so there
         // only the accuracy of F itself counts.
         const double occlusion = r.sink() ? 0.0 : std::max(0.0, std::min<double>(l.coef, l.Fu - l.coef));
-        double err = power * (std::max(rv, sv) + occlusion + l.vis_err);
+        double err = power * (kvar + occlusion + l.vis_err);
         // The link spreads the sender's mean, not its halves' values.
         if (s.child >= 0) {
             const size_t a = static_cast<size_t>(s.child);
@@ -1037,7 +1051,10 @@ std::vector<double> HierarchicalSolver::leaf_guess() const {
 // One refinement round against leaf values `leaf_bmax` (max over channels);
 // returns whether a link split.
 bool HierarchicalSolver::refine(const std::vector<double>& leaf_bmax) {
-    std::vector<double> Bn, I;
+    // The operator's scratch (no solve runs during a refinement): a fresh
+    // table array per round was hundreds of MB of new pages at 10^6 walls.
+    std::vector<double>& Bn = m_Bn;
+    std::vector<double>& I = m_I;
     pull_tables(leaf_bmax.data(), Bn, I);
     // eps_abs = eps * W / N (see the header).
     CompensatedSum W;
