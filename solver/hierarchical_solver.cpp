@@ -257,7 +257,7 @@ private:
     std::vector<Link> m_links;
     std::vector<int32_t> m_link_start;   // CSR by receiver (after sort_links)
     std::vector<int32_t> m_receivers;
-    std::vector<int> m_leaves;           // element leaves, then sink nodes
+    std::vector<int> m_leaves;           // element leaves
     int m_element_leaves = 0;
     std::vector<int> m_leaf_index;       // node -> index in m_leaves, -1 otherwise
     std::vector<char> m_reached;         // per node
@@ -1446,14 +1446,37 @@ void HierarchicalSolver::build_parts() {
     if (m_links.empty()) return;
     std::vector<char> linked(static_cast<size_t>(N), 0);
     std::vector<std::pair<int, int>> edges;
-    edges.reserve(m_links.size() + m_leaves.size());
+    edges.reserve(m_links.size() + m_nodes.size());
     for (const Link& l : m_links) {
         linked[static_cast<size_t>(l.r)] = linked[static_cast<size_t>(l.s)] = 1;
         if (l.r != l.s) edges.push_back({l.r, l.s});
     }
-    for (int leaf : m_leaves)
-        for (int p = m_nodes[static_cast<size_t>(leaf)].parent; p >= 0; p = m_nodes[static_cast<size_t>(p)].parent)
-            if (linked[static_cast<size_t>(p)]) edges.push_back({leaf, p});
+    // Per node, its nearest and its highest linked ancestor (-1: none), in
+    // one pass: parents come before their children.
+    std::vector<int> nearest(static_cast<size_t>(N), -1), highest(static_cast<size_t>(N), -1);
+    for (int k = 0; k < N; ++k) {
+        const int p = m_nodes[static_cast<size_t>(k)].parent;
+        if (p < 0) continue;
+        nearest[static_cast<size_t>(k)] = linked[static_cast<size_t>(p)] ? p : nearest[static_cast<size_t>(p)];
+        highest[static_cast<size_t>(k)] = highest[static_cast<size_t>(p)] >= 0 ? highest[static_cast<size_t>(p)]
+                                          : linked[static_cast<size_t>(p)] ? p
+                                                                           : -1;
+    }
+    // An element leaf is coupled to every linked ancestor. Chaining each
+    // element leaf, and each linked node with an element leaf below, to its
+    // nearest linked ancestor couples the same nodes with O(N) edges (a
+    // leaf below a linked node is coupled to it and to everything above).
+    std::vector<char> leaf_below(static_cast<size_t>(N), 0);
+    for (int k = N; k-- > 0;) {
+        if (m_leaf_index[static_cast<size_t>(k)] >= 0) leaf_below[static_cast<size_t>(k)] = 1;
+        const int p = m_nodes[static_cast<size_t>(k)].parent;
+        if (p >= 0 && leaf_below[static_cast<size_t>(k)]) leaf_below[static_cast<size_t>(p)] = 1;
+    }
+    for (int k = 0; k < N; ++k) {
+        const bool chained = m_leaf_index[static_cast<size_t>(k)] >= 0 ||
+                             (linked[static_cast<size_t>(k)] && leaf_below[static_cast<size_t>(k)]);
+        if (chained && nearest[static_cast<size_t>(k)] >= 0) edges.push_back({k, nearest[static_cast<size_t>(k)]});
+    }
     LightParts lp;
     if (m_opt.solve_parts_apart) {
         lp = connected_parts(N, edges);
@@ -1482,9 +1505,7 @@ void HierarchicalSolver::build_parts() {
         if (static_cast<int>(i) < m_element_leaves) part.leaves.push_back(static_cast<int>(i));
         // Its path up to its highest linked ancestor; a node already taken
         // has its path above taken too.
-        int top = leaf;
-        for (int p = m_nodes[static_cast<size_t>(leaf)].parent; p >= 0; p = m_nodes[static_cast<size_t>(p)].parent)
-            if (linked[static_cast<size_t>(p)]) top = p;
+        const int top = highest[static_cast<size_t>(leaf)] >= 0 ? highest[static_cast<size_t>(leaf)] : leaf;
         for (int k = leaf;; k = m_nodes[static_cast<size_t>(k)].parent) {
             if (m_part_of[static_cast<size_t>(k)] >= 0) break;
             m_part_of[static_cast<size_t>(k)] = id;
