@@ -984,16 +984,17 @@ void run_scale(ScaleOptions o, const std::string& cmd) {
     fmt::print("command: {}\n", cmd);
     fmt::print("program: {} (copied at start, so that a rebuild cannot change it mid-run)\n",
                (program_dir() / "flatrad").string());
-    if (o.round)
+    if (o.round) {
         fmt::print("scene: `scripts/make-scene N --round --lamps {}`: a round room of radius 1, N walls (lit in,\n"
                    "       reflectance 0.7) in one closed loop, {} of them lamps; nothing can block; cached in {}.\n",
                    o.lamps, o.lamps, scene_cache_dir().string());
-    else
-    fmt::print("scene: `scripts/make-scene N --seed {} --density {} --lamps {}`: a square room (4 segments, lit in,\n"
-               "       reflectance 0.7) of side sqrt(B / {}), {} ceiling lamp(s) and B = N - {} two-sided blockers\n"
-               "       of length 0.05-0.15 (reflectance 0.3), so the density, not the room, stays the same;\n"
-               "       cached in {}.\n",
-               o.seed, o.density, o.lamps, o.density, o.lamps, 4 + o.lamps, scene_cache_dir().string());
+    } else {
+        fmt::print("scene: `scripts/make-scene N --seed {} --density {} --lamps {}`: a square room (4 segments, lit in,\n"
+                   "       reflectance 0.7) of side sqrt(B / {}), {} ceiling lamp(s) and B = N - {} two-sided blockers\n"
+                   "       of length 0.05-0.15 (reflectance 0.3), so the density, not the room, stays the same;\n"
+                   "       cached in {}.\n",
+                   o.seed, o.density, o.lamps, o.density, o.lamps, 4 + o.lamps, scene_cache_dir().string());
+    }
     fmt::print("times: medians over {} run(s) of each size; solve = the result's stats.time_s, wall = the child's\n"
                "       whole life (start, reading, solving, writing the result), load = flatrad::load_scene of the\n"
                "       file in this process (reading and checking the scene, as the CLI does first);\n"

@@ -118,8 +118,9 @@ struct Link {
     float kvar = 0;           // element links: the kernel's variation over quarters (kernel_variation)
     bool unresolved = false;  // cluster links whose nodes overlap: must be split if they carry light
     bool clear = false;       // element links whose shaft held no blocker: nor do their children's
-    // Cluster links: transmittance not asked yet (coef unoccluded). The
-    // refinement asks only if the link is not split on its geometry alone.
+    // Visibility not asked yet (coef unoccluded): a cluster link's
+    // transmittance, an element link's occluded F. The refinement asks only
+    // if the link is not split on its geometry alone (resolve_visibility).
     bool vis_pending = false;
     // Cluster ends read through the table's linear part (directional.h):
     // every member faces every direction the link can take.
@@ -612,22 +613,20 @@ bool HierarchicalSolver::make_link(int r, int s, Link& l, VisibilityStats& st) c
         if (n.cluster()) return m_obox[static_cast<size_t>(n.hnode)].corners();
         return std::array<Vec2, 4>{n.seg.a, n.seg.b, n.seg.a, n.seg.b};
     };
-    if (ns.cluster() || nr.cluster()) {
-        const auto cs = corners(ns), cr = corners(nr);
-        if (ns.cluster()) {
-            if (ns.send_cone.faces_none(cs, cr)) {
-                ++st.culled;
-                return false;
-            }
-            l.s_linear = ns.send_cone.faces_all(cs, cr);
+    const auto cs = corners(ns), cr = corners(nr);
+    if (ns.cluster()) {
+        if (ns.send_cone.faces_none(cs, cr)) {
+            ++st.culled;
+            return false;
         }
-        if (nr.cluster()) {
-            if (nr.recv_cone.faces_none(cr, cs)) {
-                ++st.culled;
-                return false;
-            }
-            l.r_linear = nr.recv_cone.faces_all(cr, cs);
+        l.s_linear = ns.send_cone.faces_all(cs, cr);
+    }
+    if (nr.cluster()) {
+        if (nr.recv_cone.faces_none(cr, cs)) {
+            ++st.culled;
+            return false;
         }
+        l.r_linear = nr.recv_cone.faces_all(cr, cs);
     }
     // Unoccluded coefficient (tau = 1).
     double coef_u = 0;
@@ -669,8 +668,9 @@ double HierarchicalSolver::kernel_variation(const Node& r, const Node& s, double
     return std::max(rv, sv);
 }
 
-// Asks the visibility module for a pending cluster link's transmittance;
-// false when nothing passes (the link is to be dropped).
+// Asks the visibility module for a pending link's visibility (an element
+// link's occluded F, a cluster link's transmittance); false when nothing
+// passes (the link is to be dropped).
 bool HierarchicalSolver::resolve_visibility(Link& l, ExactWorkspace& ws, VisibilityStats& st) const {
     const Node& nr = m_nodes[static_cast<size_t>(l.r)];
     const Node& ns = m_nodes[static_cast<size_t>(l.s)];
@@ -1076,10 +1076,10 @@ bool HierarchicalSolver::refine(const std::vector<double>& leaf_bmax) {
     std::vector<char> dead(m_links.size(), 0);
     while (!work.empty()) {
         // 1. Decide, in parallel.
-        // A cluster link whose transmittance is pending is split on its
-        // geometry alone when that exceeds eps_abs (a lower bound of its
-        // error whatever tau is); only the others ask the visibility module
-        // (most cluster links of an occluded scene are split anyway).
+        // A link whose visibility is pending is split on its geometry alone
+        // when that exceeds eps_abs (a lower bound of its error whatever the
+        // visibility is); only the others ask the visibility module (most
+        // links of an occluded scene are split anyway).
         decision.assign(work.size(), 0);
         const long nw = static_cast<long>(work.size());
         const auto t_decide = Clock::now();
@@ -1180,7 +1180,7 @@ void HierarchicalSolver::collect_leaves() {
 // receivers without races.
 void HierarchicalSolver::sort_links() {
     for ([[maybe_unused]] const Link& l : m_links)
-        FLATRAD_ASSERT(!l.vis_pending, "a link reached the solve without its transmittance");
+        FLATRAD_ASSERT(!l.vis_pending, "a link reached the solve without its visibility");
     // Counting sort by receiver (stable: a receiver's links keep their
     // order, which is deterministic): O(links + nodes), where a comparison
     // sort of tens of millions of links took a tenth of a large solve.
