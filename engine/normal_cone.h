@@ -7,6 +7,7 @@
 /// (faces_none); both are asked for every direction between two convex
 /// regions given by their corners.
 /// Used by the hierarchical solver's directional model (solver/directional.h).
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <utility>
@@ -63,6 +64,33 @@ struct NormalCone {
     template <size_t A, size_t B>
     bool faces_none(const std::array<Vec2, A>& from, const std::array<Vec2, B>& to) const {
         return empty() || (width < std::numbers::pi && all_signed(from, to, -1.0));
+    }
+
+    /// Whether every member faces direction u, and by how much: the
+    /// smallest n . u over the members (the sine of the angle u can turn,
+    /// either way, before a member stops facing it); negative when some
+    /// member does not face u, or the arc is pi or wider (no direction is
+    /// faced by all). n . u is concave in the angle over an arc narrower
+    /// than pi inside the facing half circle, so its minimum is at an end.
+    double facing_margin(Vec2 u) const {
+        if (empty() || !(width < std::numbers::pi)) return -1;
+        const auto [n0, n1] = ends();
+        return std::min(dot(n0, u), dot(n1, u));
+    }
+
+    /// For members that all face u (facing_margin(u) >= 0): over the
+    /// directions u' within `delta` of u, how far a sum of lobes sum_i w_i
+    /// cos+(n_i . u') (w_i >= 0) can leave its linear part (sum_i w_i n_i)
+    /// . u', per unit of |sum_i w_i n_i|. A member of margin m turns away
+    /// by at most sin(delta - m); the total weight is at most |sum_i w_i
+    /// n_i| / cos(width / 2), every normal being within width / 2 of the
+    /// arc's middle. 0 when every member faces every such u'; negative when
+    /// not every member faces u.
+    double linear_departure(Vec2 u, double delta) const {
+        const double m = facing_margin(u);
+        if (!(m >= 0)) return -1;
+        const double turn = std::clamp(delta - std::asin(std::min(1.0, m)), 0.0, 0.5 * std::numbers::pi);
+        return std::sin(turn) / std::cos(0.5 * width);
     }
 
 private:

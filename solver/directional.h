@@ -86,40 +86,58 @@ inline const std::array<Vec2, directional_bins>& bin_directions() {
     return dirs;
 }
 
-/// Adds the lobe w cos+(n . u) to a table: to its samples (w cos+(n .
-/// u(phi_k))) and to its linear part (w n).
-inline void add_cosine_lobe(double* table, Vec2 n, double w) {
-    const auto& d = bin_directions();
-    for (int k = 0; k < directional_bins; ++k) {
-        const double c = n.x * d[static_cast<size_t>(k)].x + n.y * d[static_cast<size_t>(k)].y;
-        if (c > 0) table[k] += w * c;
+/// Adds the lobe w cos+(n . u) to a table held as two arrays: to its
+/// samples (w cos+(n . u(phi_k))), unless `samples` is null (a table kept
+/// without samples, solver/table_array.h), and to its linear part (w n).
+inline void add_cosine_lobe(double* samples, double* linear, Vec2 n, double w) {
+    if (samples) {
+        const auto& d = bin_directions();
+        for (int k = 0; k < directional_bins; ++k) {
+            const double c = n.x * d[static_cast<size_t>(k)].x + n.y * d[static_cast<size_t>(k)].y;
+            if (c > 0) samples[k] += w * c;
+        }
     }
-    table[directional_bins] += w * n.x;
-    table[directional_bins + 1] += w * n.y;
+    linear[0] += w * n.x;
+    linear[1] += w * n.y;
+}
+
+/// The same on a table of directional_table_width doubles.
+inline void add_cosine_lobe(double* table, Vec2 n, double w) {
+    add_cosine_lobe(table, table + directional_bins, n, w);
 }
 
 /// What an element of normal n receives from an arrival table: sum_k J_k
-/// cos+(n . u(psi_k)) from the samples, plus n . (linear part).
-inline double read_cosine_lobe(const double* table, Vec2 n) {
-    const auto& d = bin_directions();
+/// cos+(n . u(psi_k)) from the samples (none when `samples` is null), plus
+/// n . (linear part).
+inline double read_cosine_lobe(const double* samples, const double* linear, Vec2 n) {
     double s = 0;
-    for (int k = 0; k < directional_bins; ++k) {
-        const double c = n.x * d[static_cast<size_t>(k)].x + n.y * d[static_cast<size_t>(k)].y;
-        if (c > 0) s += table[k] * c;
+    if (samples) {
+        const auto& d = bin_directions();
+        for (int k = 0; k < directional_bins; ++k) {
+            const double c = n.x * d[static_cast<size_t>(k)].x + n.y * d[static_cast<size_t>(k)].y;
+            if (c > 0) s += samples[k] * c;
+        }
     }
-    return s + n.x * table[directional_bins] + n.y * table[directional_bins + 1];
+    return s + n.x * linear[0] + n.y * linear[1];
 }
 
-/// The linear part read at unit direction u.
-inline double read_linear(const double* table, Vec2 u) {
-    return table[directional_bins] * u.x + table[directional_bins + 1] * u.y;
+/// The same on a table of directional_table_width doubles.
+inline double read_cosine_lobe(const double* table, Vec2 n) {
+    return read_cosine_lobe(table, table + directional_bins, n);
 }
 
-/// Adds an arrival of weight c from direction u to the linear part.
-inline void add_linear(double* table, Vec2 u, double c) {
-    table[directional_bins] += c * u.x;
-    table[directional_bins + 1] += c * u.y;
+/// The linear part read at unit direction u (`linear`: its two numbers).
+inline double read_linear_part(const double* linear, Vec2 u) { return linear[0] * u.x + linear[1] * u.y; }
+
+/// Adds an arrival of weight c from direction u to a linear part.
+inline void add_linear_part(double* linear, Vec2 u, double c) {
+    linear[0] += c * u.x;
+    linear[1] += c * u.y;
 }
+
+/// The same two on a table of directional_table_width doubles.
+inline double read_linear(const double* table, Vec2 u) { return read_linear_part(table + directional_bins, u); }
+inline void add_linear(double* table, Vec2 u, double c) { add_linear_part(table + directional_bins, u, c); }
 
 inline double interpolate(const double* table, BinWeight b) {
     return (1 - b.t) * table[b.k] + b.t * table[b.next()];

@@ -28,6 +28,7 @@
 #include "solver/reachability.h"
 #include "solver/rooms.h"
 #include "solver/sink_visibility.h"
+#include "solver/table_array.h"
 #include "visibility/cluster_tables.h"
 #include "visibility/exact_visibility.h"
 #include "visibility/multiscale.h"
@@ -123,8 +124,13 @@ struct Link {
     // if the link is not split on its geometry alone (resolve_visibility).
     bool vis_pending = false;
     // Cluster ends read through the table's linear part (directional.h):
-    // every member faces every direction the link can take.
+    // every member faces the link's direction u, where the linear part is
+    // exact. *_back: where some member may stop facing over the directions
+    // the link can take (its spread), a bound on how far the table leaves
+    // its linear part there, relative to the linear part's norm (0 when
+    // every member faces every direction of the spread).
     bool s_linear = false, r_linear = false;
+    float s_back = 0, r_back = 0;
     Vec2 u() const { return {ux, uy}; }
 };
 
@@ -210,9 +216,9 @@ private:
     std::pair<double, double> link_transmittance(int r, int s, ExactWorkspace& ws, VisibilityStats& st) const;
     void compute_links(std::vector<Link>& links);
     int split_element(int node);
-    void pull_tables(const double* leaf_value, std::vector<double>& Bn, std::vector<double>& I,
+    void pull_tables(const double* leaf_value, std::vector<double>& Bn, TableArray& I,
                      const Part* part = nullptr) const;
-    LinkError link_error(const Link& l, const std::vector<double>& Bn, const std::vector<double>& I,
+    LinkError link_error(const Link& l, const std::vector<double>& Bn, const TableArray& I,
                          bool geometry_only = false) const;
     bool refine(const std::vector<double>& leaf_bmax);
     void collect_leaves();
@@ -220,14 +226,15 @@ private:
     void sort_links();
     void apply_G(const Eigen::VectorXd& x, Eigen::VectorXd& out, bool correct, const Part* part = nullptr);
     void build_parts();
-    void clear_scratch(std::vector<double>& per_node, std::vector<double>& tables, const Part* part) const;
+    void clear_scratch(std::vector<double>& per_node, TableArray& tables, const Part* part) const;
+    void sample_slots();
     bool in_part(const Part* part, int node, int parent) const {
         return !part || m_part_of[static_cast<size_t>(parent)] == m_part_of[static_cast<size_t>(node)];
     }
     void solve();
     std::vector<double> leaf_guess() const;
     std::vector<double> landed_fraction() const;
-    void push_down(std::vector<double>& tables, const std::vector<double>& own, double lobe_scale,
+    void push_down(TableArray& tables, const std::vector<double>& own, double lobe_scale,
                    std::vector<double>& above, const Part* part = nullptr) const;
 
     const Scene& m_scene;
@@ -256,6 +263,7 @@ private:
     int m_tables_count = 0;
     std::vector<double> m_sensitivity;  // per cluster table: sum L cos+(n . u(psi_k))
     std::vector<Link> m_links;
+    std::vector<Link> m_links_sorted, m_fresh;  // scratch of sort_links and refine, kept for their pages
     std::vector<int32_t> m_link_start;   // CSR by receiver (after sort_links)
     std::vector<int32_t> m_receivers;
     std::vector<int> m_leaves;           // element leaves
@@ -276,8 +284,13 @@ private:
     std::vector<Part> m_parts;
     std::vector<int> m_part_of;  // per node: its part, -1 when none
     long m_part_count = 0;
-    // Scratch for the operator.
-    std::vector<double> m_Bn, m_I, m_Hn, m_J, m_Ha;
+    // Scratch for the operator: per node, and the exitance (I) and
+    // arrival (J) tables, with samples only where links use them
+    // (solver/table_array.h; refinement pulls every table's samples).
+    std::vector<double> m_Bn, m_Hn, m_Ha;
+    TableArray m_I, m_J;
+    std::vector<int32_t> m_I_slot, m_J_slot;  // per table: its samples' slot, -1 for none (sample_slots)
+    int m_I_slotted = 0, m_J_slotted = 0;
     // Solution per channel, per node (B pulled, H pushed).
     std::vector<std::vector<double>> m_B, m_H;
 
@@ -456,6 +469,8 @@ void HierarchicalSolver::build_tree() {
     for (Node& n : m_nodes)
         if (n.cluster() && !n.leaf_cluster) n.table = m_tables_count++;
     m_sensitivity.assign(static_cast<size_t>(m_tables_count) * TW, 0.0);
+    m_I_slot.assign(static_cast<size_t>(m_tables_count), -1);  // no link yet: no samples
+    m_J_slot = m_I_slot;
     // can_send and sensitivity, children before parents.
     for (size_t k = m_nodes.size(); k-- > 0;) {
         Node& n = m_nodes[k];
@@ -614,19 +629,34 @@ bool HierarchicalSolver::make_link(int r, int s, Link& l, VisibilityStats& st) c
         return std::array<Vec2, 4>{n.seg.a, n.seg.b, n.seg.a, n.seg.b};
     };
     const auto cs = corners(ns), cr = corners(nr);
+    // Where every member faces u itself but not the whole spread (close
+    // clusters: a wall's neighbour along a curve), the linear part is still
+    // exact at u, and NormalCone::linear_departure bounds how far the table
+    // leaves it over the spread of +-delta.
+    const double delta = std::asin(std::min(1.0, reach / dist));
+    auto linear_end = [&](const NormalCone& cone, bool all, Vec2 dir, bool& linear, float& back) {
+        if (all) {
+            linear = true;
+            return;
+        }
+        const double departure = cone.linear_departure(dir, delta);
+        if (!(departure >= 0)) return;
+        linear = true;
+        back = static_cast<float>(departure);
+    };
     if (ns.cluster()) {
         if (ns.send_cone.faces_none(cs, cr)) {
             ++st.culled;
             return false;
         }
-        l.s_linear = ns.send_cone.faces_all(cs, cr);
+        linear_end(ns.send_cone, ns.send_cone.faces_all(cs, cr), u, l.s_linear, l.s_back);
     }
     if (nr.cluster()) {
         if (nr.recv_cone.faces_none(cr, cs)) {
             ++st.culled;
             return false;
         }
-        l.r_linear = nr.recv_cone.faces_all(cr, cs);
+        linear_end(nr.recv_cone, nr.recv_cone.faces_all(cr, cs), -u, l.r_linear, l.r_back);
     }
     // Unoccluded coefficient (tau = 1).
     double coef_u = 0;
@@ -808,26 +838,25 @@ int HierarchicalSolver::split_element(int node) {
 // Zeroes a per-node array and the per-table array that goes with it: all
 // of them, or only a part's nodes and their tables (the rest left as it
 // was, so that a small part costs what it holds).
-void HierarchicalSolver::clear_scratch(std::vector<double>& per_node, std::vector<double>& tables,
+void HierarchicalSolver::clear_scratch(std::vector<double>& per_node, TableArray& tables,
                                        const Part* part) const {
     const size_t N = m_nodes.size();
-    const size_t T = static_cast<size_t>(m_tables_count) * TW;
-    if (!part || per_node.size() != N || tables.size() != T) {
+    FLATRAD_ASSERT(tables.tables() == m_tables_count, "tables laid out before use");
+    if (!part || per_node.size() != N) {
         per_node.assign(N, 0.0);
-        tables.assign(T, 0.0);
+        tables.clear();
     }
     if (part)
         for (int k : part->nodes) {
             per_node[static_cast<size_t>(k)] = 0;
-            if (m_nodes[static_cast<size_t>(k)].table >= 0)
-                std::fill_n(&tables[static_cast<size_t>(m_nodes[static_cast<size_t>(k)].table) * TW], TW, 0.0);
+            if (m_nodes[static_cast<size_t>(k)].table >= 0) tables.clear(m_nodes[static_cast<size_t>(k)].table);
         }
 }
 
 // With a part, only its nodes are zeroed and visited (the rest of Bn and I
 // is left as it was).
 void HierarchicalSolver::pull_tables(const double* leaf_value, std::vector<double>& Bn,
-                                     std::vector<double>& I, const Part* part) const {
+                                     TableArray& I, const Part* part) const {
     const size_t N = m_nodes.size();
     clear_scratch(Bn, I, part);
     const size_t count = part ? part->nodes.size() : N;
@@ -846,16 +875,16 @@ void HierarchicalSolver::pull_tables(const double* leaf_value, std::vector<doubl
         if (n.parent < 0 || !in_part(part, static_cast<int>(k), n.parent)) continue;
         const Node& p = m_nodes[static_cast<size_t>(n.parent)];
         if (p.table < 0) continue;
-        double* dst = &I[static_cast<size_t>(p.table) * TW];
         if (n.table >= 0) {
-            const double* src = &I[static_cast<size_t>(n.table) * TW];
-            for (int b = 0; b < TW; ++b) dst[b] += src[b];
+            I.sum_child(p.table, n.table);
         } else if (n.leaf_cluster) {
+            double* samples = I.samples(p.table);
+            double* linear = I.linear(p.table);
             for (int c = n.child; c < n.child + n.nchild; ++c) {
                 const Node& side = m_nodes[static_cast<size_t>(c)];
                 if (side.kind != Kind::Element) continue;
                 const double w = 0.5 * side.length * Bn[static_cast<size_t>(c)];
-                if (w != 0) add_cosine_lobe(dst, side.normal, w);
+                if (w != 0) add_cosine_lobe(samples, linear, side.normal, w);
             }
         }
     }
@@ -864,7 +893,7 @@ void HierarchicalSolver::pull_tables(const double* leaf_value, std::vector<doubl
 // Estimated error in the power the link transports, with the sender values
 // of the current solution (Bn per node, I per cluster table), and which
 // side's approximations make most of it (split_r: the receiver's).
-LinkError HierarchicalSolver::link_error(const Link& l, const std::vector<double>& Bn, const std::vector<double>& I,
+LinkError HierarchicalSolver::link_error(const Link& l, const std::vector<double>& Bn, const TableArray& I,
                                          bool geometry_only) const {
     const Node& r = m_nodes[static_cast<size_t>(l.r)];
     const Node& s = m_nodes[static_cast<size_t>(l.s)];
@@ -894,8 +923,9 @@ LinkError HierarchicalSolver::link_error(const Link& l, const std::vector<double
         return {err, size_r >= size_s};
     }
     // Cluster links: the power carried, unoccluded, and its uncertainty.
-    // A linear read (every member faces every direction of the link) is
-    // exact at the centres' direction u. Over the nodes' extent the
+    // A linear read (every member faces u) is exact at the centres'
+    // direction u. Where members may turn away over the spread below, the
+    // link's *_back bounds what that adds (make_link). Over the nodes' extent the
     // directions spread by +-delta, where f . u' = (f . u) cos t + (f .
     // u_perp) sin t. The link reads it at the centres, a midpoint rule: the
     // first-order term cancels over a node symmetric about its centre, and
@@ -907,17 +937,18 @@ LinkError HierarchicalSolver::link_error(const Link& l, const std::vector<double
     // against exact: relative L2 1.17e-3 and 1.23e-3; default.json 8.3e-4
     // and 9.1e-4.)
     const double delta_lin = l.s_linear || l.r_linear ? std::asin(std::min(1.0, (r.radius + s.radius) / norm(r.center - s.center))) : 0.0;
-    auto linear_variation = [&](const double* t, Vec2 dir) {
-        return std::abs(read_linear(t, rot90(dir))) * delta_lin * delta_lin * delta_lin / 6 +
-               read_linear(t, dir) * 0.5 * delta_lin * delta_lin;
+    auto linear_variation = [&](const double* linear, Vec2 dir) {
+        return std::abs(read_linear_part(linear, rot90(dir))) * delta_lin * delta_lin * delta_lin / 6 +
+               read_linear_part(linear, dir) * 0.5 * delta_lin * delta_lin;
     };
     double v = 0, v_err = 0;
     if (s.cluster()) {
-        const double* t = &I[static_cast<size_t>(s.table) * TW];
         if (l.s_linear) {
-            v = read_linear(t, l.u());
-            v_err = linear_variation(t, l.u());
+            const double* lin = I.linear(s.table);
+            v = read_linear_part(lin, l.u());
+            v_err = linear_variation(lin, l.u()) + std::hypot(lin[0], lin[1]) * l.s_back;
         } else {
+            const double* t = I.samples(s.table);
             v = interpolate(t, l.sbin);
             v_err = interpolation_error(t, l.sbin);
         }
@@ -929,7 +960,7 @@ LinkError HierarchicalSolver::link_error(const Link& l, const std::vector<double
         // if the sender sends anything at all.
         double sent = v;
         if (s.cluster()) {
-            const double* t = &I[static_cast<size_t>(s.table) * TW];
+            const double* t = I.samples(s.table);
             sent = *std::max_element(t, t + K);
         }
         return sent > 0 ? LinkError{inf, size_r >= size_s} : LinkError{};
@@ -948,14 +979,14 @@ LinkError HierarchicalSolver::link_error(const Link& l, const std::vector<double
         for (int k = k0; k <= k1; ++k) hi = std::max(hi, t[((k % K) + K) % K]);
         return hi;
     };
-    const double v_hi = !s.cluster() ? v : l.s_linear ? v + v_err : highest(&I[static_cast<size_t>(s.table) * TW], l.sbin);
+    const double v_hi = !s.cluster() ? v : l.s_linear ? v + v_err : highest(I.samples(s.table), l.sbin);
     if (!(v_hi > 0)) return {};
     double sens = r.length, sens_err = 0, sens_hi = r.length;
     if (r.cluster()) {
         const double* t = &m_sensitivity[static_cast<size_t>(r.table) * TW];
         if (l.r_linear) {
             sens = read_linear(t, -l.u());
-            sens_err = linear_variation(t, -l.u());
+            sens_err = linear_variation(t + K, -l.u()) + std::hypot(t[K], t[K + 1]) * l.r_back;
             sens_hi = sens + sens_err;
         } else {
             sens = interpolate(t, l.rbin);
@@ -1054,7 +1085,8 @@ bool HierarchicalSolver::refine(const std::vector<double>& leaf_bmax) {
     // The operator's scratch (no solve runs during a refinement): a fresh
     // table array per round was hundreds of MB of new pages at 10^6 walls.
     std::vector<double>& Bn = m_Bn;
-    std::vector<double>& I = m_I;
+    TableArray& I = m_I;
+    I.reset_full(m_tables_count);  // new links may read any table's samples
     pull_tables(leaf_bmax.data(), Bn, I);
     // eps_abs = eps * W / N (see the header).
     CompensatedSum W;
@@ -1128,7 +1160,8 @@ bool HierarchicalSolver::refine(const std::vector<double>& leaf_bmax) {
         }
         if (resolved > 0) m_ff_time += seconds_since(t_decide);
         // 2. Split (serially: creates nodes), collecting the children links.
-        std::vector<Link> fresh;
+        std::vector<Link>& fresh = m_fresh;
+        fresh.clear();
         for (size_t k = 0; k < work.size(); ++k) {
             if (!decision[k]) continue;
             const Link l = m_links[static_cast<size_t>(work[k])];
@@ -1188,9 +1221,11 @@ void HierarchicalSolver::sort_links() {
         std::vector<int32_t> start(m_nodes.size() + 1, 0);
         for (const Link& l : m_links) ++start[static_cast<size_t>(l.r) + 1];
         for (size_t k = 1; k < start.size(); ++k) start[k] += start[k - 1];
-        std::vector<Link> sorted(m_links.size());
-        for (const Link& l : m_links) sorted[static_cast<size_t>(start[static_cast<size_t>(l.r)]++)] = l;
-        m_links.swap(sorted);
+        // Into a buffer kept between calls: a fresh one per call was
+        // gigabytes of new pages to zero at 10^6 walls.
+        m_links_sorted.resize(m_links.size());
+        for (const Link& l : m_links) m_links_sorted[static_cast<size_t>(start[static_cast<size_t>(l.r)]++)] = l;
+        m_links.swap(m_links_sorted);
     }
     m_receivers.clear();
     m_link_start.clear();
@@ -1203,6 +1238,39 @@ void HierarchicalSolver::sort_links() {
     m_cluster_links = 0;
     for (const Link& l : m_links)
         if (m_nodes[static_cast<size_t>(l.r)].cluster() || m_nodes[static_cast<size_t>(l.s)].cluster()) ++m_cluster_links;
+}
+
+// Which tables the operator keeps samples for (solver/table_array.h): an
+// exitance table read through its samples by some link, an arrival table
+// written through them, and every table below those (a parent's exitance
+// is the sum of its children's; a child's arrivals include its parent's).
+// Lays out m_I and m_J accordingly.
+void HierarchicalSolver::sample_slots() {
+    const size_t T = static_cast<size_t>(m_tables_count);
+    std::vector<char> need_I(T, 0), need_J(T, 0);
+    for (const Link& l : m_links) {
+        const Node& r = m_nodes[static_cast<size_t>(l.r)];
+        const Node& s = m_nodes[static_cast<size_t>(l.s)];
+        if (s.cluster() && !l.s_linear) need_I[static_cast<size_t>(s.table)] = 1;
+        if (r.cluster() && !l.r_linear) need_J[static_cast<size_t>(r.table)] = 1;
+    }
+    for (const Node& n : m_nodes)  // parents first
+        if (n.table >= 0 && n.parent >= 0) {
+            const size_t p = static_cast<size_t>(m_nodes[static_cast<size_t>(n.parent)].table);
+            need_I[static_cast<size_t>(n.table)] |= need_I[p];
+            need_J[static_cast<size_t>(n.table)] |= need_J[p];
+        }
+    auto slots = [&](const std::vector<char>& need, std::vector<int32_t>& slot) {
+        int32_t count = 0;
+        slot.assign(T, -1);
+        for (size_t t = 0; t < T; ++t)
+            if (need[t]) slot[t] = count++;
+        return count;
+    };
+    m_I_slotted = slots(need_I, m_I_slot);
+    m_J_slotted = slots(need_J, m_J_slot);
+    m_I.reset(m_I_slot, m_I_slotted);
+    m_J.reset(m_J_slot, m_J_slotted);
 }
 
 // Light flow (solver/reachability.h): which element leaves and sinks any
@@ -1252,7 +1320,7 @@ void HierarchicalSolver::reach() {
 // what reached the parent. Returns, per node, what reached it from above.
 // With a part, only its nodes are visited and written (a part's top node
 // gets nothing from above: no link ends above it).
-void HierarchicalSolver::push_down(std::vector<double>& tables, const std::vector<double>& own, double lobe_scale,
+void HierarchicalSolver::push_down(TableArray& tables, const std::vector<double>& own, double lobe_scale,
                                    std::vector<double>& above, const Part* part) const {
     const size_t N = m_nodes.size();
     if (!part || above.size() != N) above.assign(N, 0.0);
@@ -1264,19 +1332,13 @@ void HierarchicalSolver::push_down(std::vector<double>& tables, const std::vecto
         if (n.parent < 0 || !in_part(part, static_cast<int>(k), n.parent)) continue;
         const Node& p = m_nodes[static_cast<size_t>(n.parent)];
         if (n.cluster()) {
-            if (n.table >= 0 && p.table >= 0) {
-                double* dst = &tables[static_cast<size_t>(n.table) * TW];
-                const double* src = &tables[static_cast<size_t>(p.table) * TW];
-                for (int b = 0; b < TW; ++b) dst[b] += src[b];
-            }
+            if (n.table >= 0 && p.table >= 0) tables.add_parent(n.table, p.table);
             continue;
         }
         if (p.cluster()) {
             // p is a leaf cluster: no link ends there, its table is its parent's.
-            if (p.parent >= 0 && m_nodes[static_cast<size_t>(p.parent)].table >= 0)
-                above[k] = lobe_scale * read_cosine_lobe(
-                                            &tables[static_cast<size_t>(m_nodes[static_cast<size_t>(p.parent)].table) * TW],
-                                            n.normal);
+            const int t = p.parent >= 0 ? m_nodes[static_cast<size_t>(p.parent)].table : -1;
+            if (t >= 0) above[k] = lobe_scale * read_cosine_lobe(tables.samples(t), tables.linear(t), n.normal);
         } else {
             above[k] = own[static_cast<size_t>(n.parent)] + above[static_cast<size_t>(n.parent)];
         }
@@ -1299,23 +1361,26 @@ void HierarchicalSolver::apply_G(const Eigen::VectorXd& x, Eigen::VectorXd& out,
         const int r = m_receivers[static_cast<size_t>(q)];
         const Node& nr = m_nodes[static_cast<size_t>(r)];
         double h = 0;
-        double* J = nr.cluster() ? &m_J[static_cast<size_t>(nr.table) * TW] : nullptr;
+        const bool to_table = nr.cluster();
+        double* J = to_table ? m_J.samples(nr.table) : nullptr;
+        double* J_linear = to_table ? m_J.linear(nr.table) : nullptr;
         for (int32_t k = m_link_start[static_cast<size_t>(q)]; k < m_link_start[static_cast<size_t>(q) + 1]; ++k) {
             const Link& l = m_links[static_cast<size_t>(k)];
             const Node& ns = m_nodes[static_cast<size_t>(l.s)];
-            const double* I = ns.cluster() ? &m_I[static_cast<size_t>(ns.table) * TW] : nullptr;
-            const double v = !I ? m_Bn[static_cast<size_t>(l.s)] : l.s_linear ? read_linear(I, l.u()) : interpolate(I, l.sbin);
+            const double v = !ns.cluster() ? m_Bn[static_cast<size_t>(l.s)]
+                             : l.s_linear  ? read_linear_part(m_I.linear(ns.table), l.u())
+                                           : interpolate(m_I.samples(ns.table), l.sbin);
             const double c = l.coef * v;
-            if (J && l.r_linear) {
-                add_linear(J, -l.u(), c);  // arrives from the sender's direction
-            } else if (J) {
+            if (to_table && l.r_linear) {
+                add_linear_part(J_linear, -l.u(), c);  // arrives from the sender's direction
+            } else if (to_table) {
                 J[l.rbin.k] += (1 - l.rbin.t) * c;
                 J[l.rbin.next()] += l.rbin.t * c;
             } else {
                 h += c;
             }
         }
-        if (!J) m_Hn[static_cast<size_t>(r)] = h;
+        if (!to_table) m_Hn[static_cast<size_t>(r)] = h;
     }
     // Push: tables down the clusters, then onto sides, then down elements.
     push_down(m_J, m_Hn, 1.0, m_Ha, part);  // m_Ha: what arrived at ancestors (row-sum correction)
@@ -1341,6 +1406,7 @@ void HierarchicalSolver::solve() {
     const auto t0 = Clock::now();
     collect_leaves();
     sort_links();
+    sample_slots();
     const Eigen::Index n = static_cast<Eigen::Index>(m_element_leaves);
     // Row sums: a leaf of a patch whose light cannot leave the scene and
     // that sees no sink must gather exactly 1 for B = 1 everywhere. Probed
@@ -1362,6 +1428,7 @@ void HierarchicalSolver::solve() {
     }
     reach();
     sort_links();
+    sample_slots();
     build_parts();
     // Krylov runs start from the previous round's solution (a new half
     // from the element it halves): a refinement round changes few links,
@@ -1536,17 +1603,19 @@ void HierarchicalSolver::build_parts() {
 // pushed down the clusters and read through each side's cosine lobe, / 2).
 std::vector<double> HierarchicalSolver::landed_fraction() const {
     const size_t N = m_nodes.size();
-    std::vector<double> own(N, 0.0), lam(static_cast<size_t>(m_tables_count) * TW, 0.0);
+    std::vector<double> own(N, 0.0);
+    TableArray lam;  // the adjoint has samples where the links read I's (the same slots)
+    lam.reset(m_I_slot, m_I_slotted);
     for (const Link& l : m_links) {
         const Node& r = m_nodes[static_cast<size_t>(l.r)];
         const Node& s = m_nodes[static_cast<size_t>(l.s)];
         const double* S = r.cluster() ? &m_sensitivity[static_cast<size_t>(r.table) * TW] : nullptr;
         const double d = l.coef * (!S ? r.length : l.r_linear ? read_linear(S, -l.u()) : interpolate(S, l.rbin));
         if (s.cluster()) {
-            double* t = &lam[static_cast<size_t>(s.table) * TW];
             if (l.s_linear) {
-                add_linear(t, l.u(), d);
+                add_linear_part(lam.linear(s.table), l.u(), d);
             } else {
+                double* t = lam.samples(s.table);
                 t[l.sbin.k] += (1 - l.sbin.t) * d;
                 t[l.sbin.next()] += l.sbin.t * d;
             }
@@ -1653,6 +1722,8 @@ Solution HierarchicalSolver::run() {
     sol.stats.links = static_cast<long>(m_links.size());
     sol.stats.patches_left_out = m_left_out;
     sol.stats.cluster_links = m_cluster_links;
+    sol.stats.cluster_tables = m_tables_count;
+    sol.stats.sampled_tables = std::max(m_I_slotted, m_J_slotted);
     sol.stats.independent_parts = m_part_count;
     sol.stats.iterations = m_iterations;
     sol.stats.residual = m_residual;

@@ -46,6 +46,8 @@ struct SolveStats {
     long patches_left_out = 0;  ///< hierarchical: patches no emitter can reach (not solved; B = E = 0)
     long cluster_links = 0;     ///< hierarchical: links with a cluster at either end (part of `links`)
     long independent_parts = 0; ///< hierarchical: sub-scenes no light passes between, solved apart
+    long cluster_tables = 0;    ///< hierarchical: clusters with a directional model (solver/directional.h)
+    long sampled_tables = 0;    ///< hierarchical: of those, the ones whose samples the final solve kept (the rest: linear part only)
     double residual = 0;     ///< max over channels of ||(I - rho F) B - E||_inf / ||E||_inf
     int threads = 1;
     VisibilityStats visibility;

@@ -85,6 +85,8 @@ ordered_json result_json(const Scene& scene, const Solution& solution) {
     stats["patches_left_out"] = s.patches_left_out;
     stats["cluster_links"] = s.cluster_links;
     stats["independent_parts"] = s.independent_parts;
+    stats["cluster_tables"] = s.cluster_tables;
+    stats["sampled_tables"] = s.sampled_tables;
     stats["residual"] = s.residual;
     stats["threads"] = s.threads;
     stats["form_factor_time_s"] = s.form_factor_time_s;
