@@ -96,6 +96,27 @@ struct Node {
     bool sink() const { return kind == Kind::Sink; }
 };
 
+// The operator's view of a node: the fields that pull_tables, push_down and
+// the gather read, 56 bytes against Node's 184, so that their passes over
+// millions of nodes (and the gather's scattered reads of senders) move a
+// third of the memory. Rebuilt from m_nodes by collect_leaves.
+struct OpNode {
+    int32_t parent = -1;
+    int32_t child = -1;     // elements: first half (-1: a leaf); leaf clusters: first side
+    int32_t nchild = 0;
+    int32_t table = -1;     // clusters that are not hierarchy leaves: their tables
+    // The table a node's light goes up into (pull) or comes down from (push):
+    // a cluster's parent's; a side's (an element or sink right under a leaf
+    // cluster) its leaf cluster's parent's; -1 for pieces of elements.
+    int32_t up_table = -1;
+    int32_t leaf = -1;      // element leaves: index in m_leaves
+    Kind kind = Kind::Cluster;
+    bool leaf_cluster = false;
+    bool side = false;      // an element or sink right under a leaf cluster
+    Vec2 normal;            // elements and sinks
+    double length = 0;      // elements and sinks
+};
+
 // A link carries light from sender s to receiver r (DESIGN.md §3).
 //   sender value v = I_s(phi) (cluster: exitance table read at the link's
 //                    direction) or B_s (element);
@@ -110,13 +131,12 @@ struct Node {
 //   cluster <- cluster: tau / d.
 struct Link {
     int32_t r = -1, s = -1;
-    double coef = 0;
-    BinWeight sbin, rbin;     // exitance direction at s, arrival direction at r
-    float tau = 1;            // transmittance (cluster links), F / F_unoccluded (element links)
-    float vis_err = 0;        // visibility bound: on tau (cluster links) or on F (element links)
-    float ux = 0, uy = 0;     // cluster links: unit direction from s's centre to r's
-    float Fu = 0;             // element links: unoccluded F
-    float kvar = 0;           // element links: the kernel's variation over quarters (kernel_variation)
+    // Exitance direction at s, arrival direction at r (directional.h's
+    // BinWeight, packed: a link is 64 bytes, and there are 10^7 of them at
+    // 10^6 walls; a float weight rounds the interpolation by ~1e-7, the
+    // same rounding for the operator and its adjoint).
+    float st = 0, rt = 0;
+    uint8_t sk = 0, rk = 0;
     bool unresolved = false;  // cluster links whose nodes overlap: must be split if they carry light
     bool clear = false;       // element links whose shaft held no blocker: nor do their children's
     // Visibility not asked yet (coef unoccluded): a cluster link's
@@ -130,9 +150,18 @@ struct Link {
     // its linear part there, relative to the linear part's norm (0 when
     // every member faces every direction of the spread).
     bool s_linear = false, r_linear = false;
+    double coef = 0;
+    float tau = 1;            // transmittance (cluster links), F / F_unoccluded (element links)
+    float vis_err = 0;        // visibility bound: on tau (cluster links) or on F (element links)
+    float ux = 0, uy = 0;     // cluster links: unit direction from s's centre to r's
+    float Fu = 0;             // element links: unoccluded F
+    float kvar = 0;           // element links: the kernel's variation over quarters (kernel_variation)
     float s_back = 0, r_back = 0;
     Vec2 u() const { return {ux, uy}; }
+    BinWeight sbin() const { return {sk, st}; }
+    BinWeight rbin() const { return {rk, rt}; }
 };
+static_assert(sizeof(Link) == 64);
 
 Link link_between(int r, int s) {
     Link l;
@@ -269,6 +298,7 @@ private:
     std::vector<int> m_leaves;           // element leaves
     int m_element_leaves = 0;
     std::vector<int> m_leaf_index;       // node -> index in m_leaves, -1 otherwise
+    std::vector<OpNode> m_op;            // per node (collect_leaves)
     std::vector<char> m_reached;         // per node
     long m_left_out = 0;
     // Row sums (see the header): per leaf, the deficit 1 - (sum of what its
@@ -616,8 +646,11 @@ bool HierarchicalSolver::make_link(int r, int s, Link& l, VisibilityStats& st) c
         return true;
     }
     const Vec2 u = d / dist;  // from s to r
-    l.sbin = bin_of(u);
-    l.rbin = bin_of(-u);
+    const BinWeight sbin = bin_of(u), rbin = bin_of(-u);
+    l.sk = static_cast<uint8_t>(sbin.k);
+    l.st = static_cast<float>(sbin.t);
+    l.rk = static_cast<uint8_t>(rbin.k);
+    l.rt = static_cast<float>(rbin.t);
     l.ux = static_cast<float>(u.x);
     l.uy = static_cast<float>(u.y);
     // A cluster none of whose senders faces any point of r from where it
@@ -858,30 +891,28 @@ void HierarchicalSolver::clear_scratch(std::vector<double>& per_node, TableArray
 void HierarchicalSolver::pull_tables(const double* leaf_value, std::vector<double>& Bn,
                                      TableArray& I, const Part* part) const {
     const size_t N = m_nodes.size();
+    FLATRAD_ASSERT(m_op.size() == N, "nodes indexed for the operator (collect_leaves)");
     clear_scratch(Bn, I, part);
     const size_t count = part ? part->nodes.size() : N;
     for (size_t q = count; q-- > 0;) {
         const size_t k = part ? static_cast<size_t>(part->nodes[q]) : q;
-        const Node& n = m_nodes[k];
+        const OpNode& n = m_op[k];
         if (n.kind == Kind::Element) {
             if (n.child < 0) {
-                const int i = m_leaf_index[k];
-                Bn[k] = i >= 0 ? leaf_value[static_cast<size_t>(i)] : 0.0;
+                Bn[k] = n.leaf >= 0 ? leaf_value[static_cast<size_t>(n.leaf)] : 0.0;
             } else {
                 const size_t a = static_cast<size_t>(n.child);
                 Bn[k] = 0.5 * (Bn[a] + Bn[a + 1]);  // halves of equal length
             }
         }
-        if (n.parent < 0 || !in_part(part, static_cast<int>(k), n.parent)) continue;
-        const Node& p = m_nodes[static_cast<size_t>(n.parent)];
-        if (p.table < 0) continue;
+        if (n.kind != Kind::Cluster || n.up_table < 0 || !in_part(part, static_cast<int>(k), n.parent)) continue;
         if (n.table >= 0) {
-            I.sum_child(p.table, n.table);
+            I.sum_child(n.up_table, n.table);
         } else if (n.leaf_cluster) {
-            double* samples = I.samples(p.table);
-            double* linear = I.linear(p.table);
+            double* samples = I.samples(n.up_table);
+            double* linear = I.linear(n.up_table);
             for (int c = n.child; c < n.child + n.nchild; ++c) {
-                const Node& side = m_nodes[static_cast<size_t>(c)];
+                const OpNode& side = m_op[static_cast<size_t>(c)];
                 if (side.kind != Kind::Element) continue;
                 const double w = 0.5 * side.length * Bn[static_cast<size_t>(c)];
                 if (w != 0) add_cosine_lobe(samples, linear, side.normal, w);
@@ -949,8 +980,8 @@ LinkError HierarchicalSolver::link_error(const Link& l, const std::vector<double
             v_err = linear_variation(lin, l.u()) + std::hypot(lin[0], lin[1]) * l.s_back;
         } else {
             const double* t = I.samples(s.table);
-            v = interpolate(t, l.sbin);
-            v_err = interpolation_error(t, l.sbin);
+            v = interpolate(t, l.sbin());
+            v_err = interpolation_error(t, l.sbin());
         }
     } else {
         v = Bn[static_cast<size_t>(l.s)];
@@ -979,7 +1010,7 @@ LinkError HierarchicalSolver::link_error(const Link& l, const std::vector<double
         for (int k = k0; k <= k1; ++k) hi = std::max(hi, t[((k % K) + K) % K]);
         return hi;
     };
-    const double v_hi = !s.cluster() ? v : l.s_linear ? v + v_err : highest(I.samples(s.table), l.sbin);
+    const double v_hi = !s.cluster() ? v : l.s_linear ? v + v_err : highest(I.samples(s.table), l.sbin());
     if (!(v_hi > 0)) return {};
     double sens = r.length, sens_err = 0, sens_hi = r.length;
     if (r.cluster()) {
@@ -989,9 +1020,9 @@ LinkError HierarchicalSolver::link_error(const Link& l, const std::vector<double
             sens_err = linear_variation(t + K, -l.u()) + std::hypot(t[K], t[K + 1]) * l.r_back;
             sens_hi = sens + sens_err;
         } else {
-            sens = interpolate(t, l.rbin);
-            sens_err = interpolation_error(t, l.rbin);
-            sens_hi = highest(t, l.rbin);
+            sens = interpolate(t, l.rbin());
+            sens_err = interpolation_error(t, l.rbin());
+            sens_hi = highest(t, l.rbin());
         }
     }
     const double tau = l.tau;
@@ -1031,11 +1062,11 @@ LinkError HierarchicalSolver::link_error(const Link& l, const std::vector<double
     };
     double rel_r = 0, rel_s = 0;
     if (r.cluster())
-        rel_r = 2 * r.radius / dist + layered(r, l.rbin) + (sens > 0 ? sens_err / sens : 0);
+        rel_r = 2 * r.radius / dist + layered(r, l.rbin()) + (sens > 0 ? sens_err / sens : 0);
     else
         rel_r = r.radius / dist;
     if (s.cluster())
-        rel_s = 2 * s.radius / dist + layered(s, l.sbin) + v_err / v;
+        rel_s = 2 * s.radius / dist + layered(s, l.sbin()) + v_err / v;
     else
         rel_s = 2 * s.radius / dist;
     // The part no transmittance changes (unocc and the relative terms do
@@ -1207,6 +1238,27 @@ void HierarchicalSolver::collect_leaves() {
             m_leaves.push_back(static_cast<int>(k));
         }
     m_element_leaves = static_cast<int>(m_leaves.size());
+    m_op.resize(m_nodes.size());
+    for (size_t k = 0; k < m_nodes.size(); ++k) {
+        const Node& n = m_nodes[k];
+        OpNode& o = m_op[k];
+        o.parent = n.parent;
+        o.child = n.child;
+        o.nchild = n.nchild;
+        o.table = n.table;
+        o.leaf = m_leaf_index[k];
+        o.kind = n.kind;
+        o.leaf_cluster = n.leaf_cluster;
+        o.normal = n.normal;
+        o.length = n.length;
+        const Node* p = n.parent >= 0 ? &m_nodes[static_cast<size_t>(n.parent)] : nullptr;
+        o.side = !n.cluster() && p && p->cluster();
+        o.up_table = -1;
+        if (n.cluster() && p)
+            o.up_table = p->table;
+        else if (o.side && p->parent >= 0)
+            o.up_table = m_nodes[static_cast<size_t>(p->parent)].table;
+    }
 }
 
 // Groups links by receiver (CSR) so that the gather runs in parallel over
@@ -1323,22 +1375,20 @@ void HierarchicalSolver::reach() {
 void HierarchicalSolver::push_down(TableArray& tables, const std::vector<double>& own, double lobe_scale,
                                    std::vector<double>& above, const Part* part) const {
     const size_t N = m_nodes.size();
+    FLATRAD_ASSERT(m_op.size() == N, "nodes indexed for the operator (collect_leaves)");
     if (!part || above.size() != N) above.assign(N, 0.0);
     const size_t count = part ? part->nodes.size() : N;
     for (size_t q = 0; q < count; ++q) {
         const size_t k = part ? static_cast<size_t>(part->nodes[q]) : q;
-        const Node& n = m_nodes[k];
+        const OpNode& n = m_op[k];
         above[k] = 0;
         if (n.parent < 0 || !in_part(part, static_cast<int>(k), n.parent)) continue;
-        const Node& p = m_nodes[static_cast<size_t>(n.parent)];
-        if (n.cluster()) {
-            if (n.table >= 0 && p.table >= 0) tables.add_parent(n.table, p.table);
-            continue;
-        }
-        if (p.cluster()) {
-            // p is a leaf cluster: no link ends there, its table is its parent's.
-            const int t = p.parent >= 0 ? m_nodes[static_cast<size_t>(p.parent)].table : -1;
-            if (t >= 0) above[k] = lobe_scale * read_cosine_lobe(tables.samples(t), tables.linear(t), n.normal);
+        if (n.kind == Kind::Cluster) {
+            if (n.table >= 0 && n.up_table >= 0) tables.add_parent(n.table, n.up_table);
+        } else if (n.side) {
+            // Its leaf cluster: no link ends there, its table is its parent's.
+            if (n.up_table >= 0)
+                above[k] = lobe_scale * read_cosine_lobe(tables.samples(n.up_table), tables.linear(n.up_table), n.normal);
         } else {
             above[k] = own[static_cast<size_t>(n.parent)] + above[static_cast<size_t>(n.parent)];
         }
@@ -1366,16 +1416,17 @@ void HierarchicalSolver::apply_G(const Eigen::VectorXd& x, Eigen::VectorXd& out,
         double* J_linear = to_table ? m_J.linear(nr.table) : nullptr;
         for (int32_t k = m_link_start[static_cast<size_t>(q)]; k < m_link_start[static_cast<size_t>(q) + 1]; ++k) {
             const Link& l = m_links[static_cast<size_t>(k)];
-            const Node& ns = m_nodes[static_cast<size_t>(l.s)];
-            const double v = !ns.cluster() ? m_Bn[static_cast<size_t>(l.s)]
-                             : l.s_linear  ? read_linear_part(m_I.linear(ns.table), l.u())
-                                           : interpolate(m_I.samples(ns.table), l.sbin);
+            const int32_t t = m_op[static_cast<size_t>(l.s)].table;  // -1: an element sends its mean
+            const double v = t < 0        ? m_Bn[static_cast<size_t>(l.s)]
+                             : l.s_linear ? read_linear_part(m_I.linear(t), l.u())
+                                          : interpolate(m_I.samples(t), l.sbin());
             const double c = l.coef * v;
             if (to_table && l.r_linear) {
                 add_linear_part(J_linear, -l.u(), c);  // arrives from the sender's direction
             } else if (to_table) {
-                J[l.rbin.k] += (1 - l.rbin.t) * c;
-                J[l.rbin.next()] += l.rbin.t * c;
+                const BinWeight b = l.rbin();
+                J[b.k] += (1 - b.t) * c;
+                J[b.next()] += b.t * c;
             } else {
                 h += c;
             }
@@ -1610,14 +1661,15 @@ std::vector<double> HierarchicalSolver::landed_fraction() const {
         const Node& r = m_nodes[static_cast<size_t>(l.r)];
         const Node& s = m_nodes[static_cast<size_t>(l.s)];
         const double* S = r.cluster() ? &m_sensitivity[static_cast<size_t>(r.table) * TW] : nullptr;
-        const double d = l.coef * (!S ? r.length : l.r_linear ? read_linear(S, -l.u()) : interpolate(S, l.rbin));
+        const double d = l.coef * (!S ? r.length : l.r_linear ? read_linear(S, -l.u()) : interpolate(S, l.rbin()));
         if (s.cluster()) {
             if (l.s_linear) {
                 add_linear_part(lam.linear(s.table), l.u(), d);
             } else {
                 double* t = lam.samples(s.table);
-                t[l.sbin.k] += (1 - l.sbin.t) * d;
-                t[l.sbin.next()] += l.sbin.t * d;
+                const BinWeight b = l.sbin();
+                t[b.k] += (1 - b.t) * d;
+                t[b.next()] += b.t * d;
             }
         } else {
             own[static_cast<size_t>(l.s)] += d / s.length;
