@@ -57,13 +57,13 @@ struct NormalCone {
     /// lies in the half circle of any w its two ends are positive on.
     template <size_t A, size_t B>
     bool faces_all(const std::array<Vec2, A>& from, const std::array<Vec2, B>& to) const {
-        return !empty() && width < std::numbers::pi && all_signed(from, to, 1.0);
+        return !empty() && width < std::numbers::pi && all_signed(ends(), from, to, 1.0);
     }
     /// No member faces any point of `to` from any point of `from` (an empty
     /// cone faces nothing).
     template <size_t A, size_t B>
     bool faces_none(const std::array<Vec2, A>& from, const std::array<Vec2, B>& to) const {
-        return empty() || (width < std::numbers::pi && all_signed(from, to, -1.0));
+        return empty() || (width < std::numbers::pi && all_signed(ends(), from, to, -1.0));
     }
 
     /// Whether every member faces direction u, and by how much: the
@@ -74,8 +74,7 @@ struct NormalCone {
     /// than pi inside the facing half circle, so its minimum is at an end.
     double facing_margin(Vec2 u) const {
         if (empty() || !(width < std::numbers::pi)) return -1;
-        const auto [n0, n1] = ends();
-        return std::min(dot(n0, u), dot(n1, u));
+        return margin(ends(), u);
     }
 
     /// For members that all face u (facing_margin(u) >= 0): over the
@@ -86,17 +85,40 @@ struct NormalCone {
     /// n_i| / cos(width / 2), every normal being within width / 2 of the
     /// arc's middle. 0 when every member faces every such u'; negative when
     /// not every member faces u.
-    double linear_departure(Vec2 u, double delta) const {
-        const double m = facing_margin(u);
+    double linear_departure(Vec2 u, double delta) const { return departure(facing_margin(u), delta); }
+
+    /// The three answers above between regions `from` and `to`, for the
+    /// direction u between them and a spread delta, with the arc's ends
+    /// computed once (the hierarchical solver asks them for every link).
+    struct Facing {
+        bool none = true;        ///< faces_none(from, to)
+        bool all = false;        ///< faces_all(from, to)
+        double departure = -1;   ///< linear_departure(u, delta)
+    };
+    template <size_t A, size_t B>
+    Facing facing(const std::array<Vec2, A>& from, const std::array<Vec2, B>& to, Vec2 u, double delta) const {
+        Facing f;
+        if (empty()) return f;
+        f.none = false;
+        if (!(width < std::numbers::pi)) return f;
+        const std::pair<Vec2, Vec2> e = ends();
+        f.none = all_signed(e, from, to, -1.0);
+        f.all = all_signed(e, from, to, 1.0);
+        f.departure = departure(margin(e, u), delta);
+        return f;
+    }
+
+private:
+    static double margin(const std::pair<Vec2, Vec2>& e, Vec2 u) { return std::min(dot(e.first, u), dot(e.second, u)); }
+    double departure(double m, double delta) const {
         if (!(m >= 0)) return -1;
         const double turn = std::clamp(delta - std::asin(std::min(1.0, m)), 0.0, 0.5 * std::numbers::pi);
         return std::sin(turn) / std::cos(0.5 * width);
     }
-
-private:
     template <size_t A, size_t B>
-    bool all_signed(const std::array<Vec2, A>& from, const std::array<Vec2, B>& to, double sign) const {
-        const auto [n0, n1] = ends();
+    static bool all_signed(const std::pair<Vec2, Vec2>& e, const std::array<Vec2, A>& from, const std::array<Vec2, B>& to,
+                           double sign) {
+        const auto [n0, n1] = e;
         for (const Vec2 f : from)
             for (const Vec2 t : to) {
                 const Vec2 w = t - f;

@@ -253,6 +253,7 @@ private:
     void collect_leaves();
     void reach();
     void sort_links();
+    void index_receivers();
     void apply_G(const Eigen::VectorXd& x, Eigen::VectorXd& out, bool correct, const Part* part = nullptr);
     void build_parts();
     void clear_scratch(std::vector<double>& per_node, TableArray& tables, const Part* part) const;
@@ -293,6 +294,7 @@ private:
     std::vector<double> m_sensitivity;  // per cluster table: sum L cos+(n . u(psi_k))
     std::vector<Link> m_links;
     std::vector<Link> m_links_sorted, m_fresh;  // scratch of sort_links and refine, kept for their pages
+    size_t m_sorted_links = 0;  // how many of m_links, from the first, are sorted by receiver
     std::vector<int32_t> m_link_start;   // CSR by receiver (after sort_links)
     std::vector<int32_t> m_receivers;
     std::vector<int> m_leaves;           // element leaves
@@ -667,29 +669,23 @@ bool HierarchicalSolver::make_link(int r, int s, Link& l, VisibilityStats& st) c
     // exact at u, and NormalCone::linear_departure bounds how far the table
     // leaves it over the spread of +-delta.
     const double delta = std::asin(std::min(1.0, reach / dist));
-    auto linear_end = [&](const NormalCone& cone, bool all, Vec2 dir, bool& linear, float& back) {
-        if (all) {
-            linear = true;
-            return;
-        }
-        const double departure = cone.linear_departure(dir, delta);
-        if (!(departure >= 0)) return;
-        linear = true;
-        back = static_cast<float>(departure);
-    };
     if (ns.cluster()) {
-        if (ns.send_cone.faces_none(cs, cr)) {
+        const NormalCone::Facing f = ns.send_cone.facing(cs, cr, u, delta);
+        if (f.none) {
             ++st.culled;
             return false;
         }
-        linear_end(ns.send_cone, ns.send_cone.faces_all(cs, cr), u, l.s_linear, l.s_back);
+        l.s_linear = f.all || f.departure >= 0;
+        l.s_back = f.all ? 0.0f : static_cast<float>(std::max(0.0, f.departure));
     }
     if (nr.cluster()) {
-        if (nr.recv_cone.faces_none(cr, cs)) {
+        const NormalCone::Facing f = nr.recv_cone.facing(cr, cs, -u, delta);
+        if (f.none) {
             ++st.culled;
             return false;
         }
-        linear_end(nr.recv_cone, nr.recv_cone.faces_all(cr, cs), -u, l.r_linear, l.r_back);
+        l.r_linear = f.all || f.departure >= 0;
+        l.r_back = f.all ? 0.0f : static_cast<float>(std::max(0.0, f.departure));
     }
     // Unoccluded coefficient (tau = 1).
     double coef_u = 0;
@@ -1222,9 +1218,15 @@ bool HierarchicalSolver::refine(const std::vector<double>& leaf_bmax) {
         }
         progress(fmt::format("refining: {} links", m_links.size()), -1);
     }
+    // Compact, keeping the order: the survivors of the sorted prefix stay
+    // sorted (sort_links merges the rest in).
     size_t w = 0;
-    for (size_t k = 0; k < m_links.size(); ++k)
+    const size_t prefix = m_sorted_links;
+    for (size_t k = 0; k < m_links.size(); ++k) {
+        if (k == prefix) m_sorted_links = w;
         if (!dead[k]) m_links[w++] = m_links[k];
+    }
+    if (prefix >= m_links.size()) m_sorted_links = w;
     m_links.resize(w);
     return any;
 }
@@ -1266,19 +1268,45 @@ void HierarchicalSolver::collect_leaves() {
 void HierarchicalSolver::sort_links() {
     for ([[maybe_unused]] const Link& l : m_links)
         FLATRAD_ASSERT(!l.vis_pending, "a link reached the solve without its visibility");
-    // Counting sort by receiver (stable: a receiver's links keep their
-    // order, which is deterministic): O(links + nodes), where a comparison
-    // sort of tens of millions of links took a tenth of a large solve.
-    {
+    // The first m_sorted_links links are sorted by receiver already (the
+    // survivors of the last sort, in order): only the rest is sorted, by
+    // counting (stable: a receiver's links keep their order, which is
+    // deterministic; O(links + nodes), where a comparison sort of tens of
+    // millions of links took a tenth of a large solve), and then merged in,
+    // both into buffers kept between calls (a fresh one per call was
+    // gigabytes of new pages to zero at 10^6 walls). After the first
+    // round, a refinement adds a few percent of the links, and the merge
+    // reads and writes the rest in order.
+    const size_t n = m_links.size(), sorted = std::min(m_sorted_links, n);
+    if (sorted < n) {
         std::vector<int32_t> start(m_nodes.size() + 1, 0);
-        for (const Link& l : m_links) ++start[static_cast<size_t>(l.r) + 1];
+        for (size_t k = sorted; k < n; ++k) ++start[static_cast<size_t>(m_links[k].r) + 1];
         for (size_t k = 1; k < start.size(); ++k) start[k] += start[k - 1];
-        // Into a buffer kept between calls: a fresh one per call was
-        // gigabytes of new pages to zero at 10^6 walls.
-        m_links_sorted.resize(m_links.size());
-        for (const Link& l : m_links) m_links_sorted[static_cast<size_t>(start[static_cast<size_t>(l.r)]++)] = l;
+        // Room to grow: the next refinement appends to these links. (Its
+        // contents are scratch: cleared first, so that growing copies nothing.)
+        if (m_links_sorted.capacity() < n) {
+            m_links_sorted.clear();
+            m_links_sorted.reserve(n + n / 4);
+        }
+        m_links_sorted.resize(n);
+        std::vector<Link>& rest = sorted == 0 ? m_links_sorted : m_fresh;  // nothing to merge: straight in
+        rest.resize(n - sorted);
+        for (size_t k = sorted; k < n; ++k)
+            rest[static_cast<size_t>(start[static_cast<size_t>(m_links[k].r)]++)] = m_links[k];
+        if (sorted > 0)
+            std::merge(m_links.begin(), m_links.begin() + static_cast<std::ptrdiff_t>(sorted), m_fresh.begin(),
+                       m_fresh.end(), m_links_sorted.begin(), [](const Link& a, const Link& b) { return a.r < b.r; });
         m_links.swap(m_links_sorted);
     }
+    m_sorted_links = n;
+    FLATRAD_ASSERT(std::is_sorted(m_links.begin(), m_links.end(), [](const Link& a, const Link& b) { return a.r < b.r; }),
+                   "links sorted by receiver");
+    index_receivers();
+}
+
+// The CSR of links sorted by receiver: each receiver and where its links
+// start; and the count of cluster links.
+void HierarchicalSolver::index_receivers() {
     m_receivers.clear();
     m_link_start.clear();
     for (size_t k = 0; k < m_links.size(); ++k)
@@ -1289,7 +1317,8 @@ void HierarchicalSolver::sort_links() {
     m_link_start.push_back(static_cast<int32_t>(m_links.size()));
     m_cluster_links = 0;
     for (const Link& l : m_links)
-        if (m_nodes[static_cast<size_t>(l.r)].cluster() || m_nodes[static_cast<size_t>(l.s)].cluster()) ++m_cluster_links;
+        if (m_op[static_cast<size_t>(l.r)].kind == Kind::Cluster || m_op[static_cast<size_t>(l.s)].kind == Kind::Cluster)
+            ++m_cluster_links;
 }
 
 // Which tables the operator keeps samples for (solver/table_array.h): an
@@ -1301,14 +1330,13 @@ void HierarchicalSolver::sample_slots() {
     const size_t T = static_cast<size_t>(m_tables_count);
     std::vector<char> need_I(T, 0), need_J(T, 0);
     for (const Link& l : m_links) {
-        const Node& r = m_nodes[static_cast<size_t>(l.r)];
-        const Node& s = m_nodes[static_cast<size_t>(l.s)];
-        if (s.cluster() && !l.s_linear) need_I[static_cast<size_t>(s.table)] = 1;
-        if (r.cluster() && !l.r_linear) need_J[static_cast<size_t>(r.table)] = 1;
+        const int32_t rt = m_op[static_cast<size_t>(l.r)].table, st = m_op[static_cast<size_t>(l.s)].table;
+        if (st >= 0 && !l.s_linear) need_I[static_cast<size_t>(st)] = 1;
+        if (rt >= 0 && !l.r_linear) need_J[static_cast<size_t>(rt)] = 1;
     }
-    for (const Node& n : m_nodes)  // parents first
-        if (n.table >= 0 && n.parent >= 0) {
-            const size_t p = static_cast<size_t>(m_nodes[static_cast<size_t>(n.parent)].table);
+    for (const OpNode& n : m_op)  // parents first
+        if (n.table >= 0 && n.up_table >= 0) {
+            const size_t p = static_cast<size_t>(n.up_table);
             need_I[static_cast<size_t>(n.table)] |= need_I[p];
             need_J[static_cast<size_t>(n.table)] |= need_J[p];
         }
@@ -1363,6 +1391,7 @@ void HierarchicalSolver::reach() {
     m_links.erase(std::remove_if(m_links.begin(), m_links.end(),
                                  [&](const Link& l) { return !reached2[static_cast<size_t>(N + l.s)]; }),
                   m_links.end());
+    m_sorted_links = std::min(m_sorted_links, m_links.size());  // remove_if keeps the order
 }
 
 // Top-down push, shared by the operator and its adjoint (landed_fraction):
@@ -1477,9 +1506,8 @@ void HierarchicalSolver::solve() {
             m_own_sum[static_cast<size_t>(i)] = m_Hn[static_cast<size_t>(node)];
         }
     }
-    reach();
-    sort_links();
-    sample_slots();
+    reach();  // drops links, keeping the order: still sorted by receiver
+    index_receivers();  // (the slots above still hold every table a link uses)
     build_parts();
     // Krylov runs start from the previous round's solution (a new half
     // from the element it halves): a refinement round changes few links,

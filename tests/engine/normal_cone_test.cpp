@@ -104,6 +104,13 @@ TEST_CASE("normal cone: faces_all and faces_none agree with dense sampling") {
         // sampled).
         CHECK(c.faces_all(from, to) == every);
         CHECK(c.faces_none(from, to) == no);
+        // The combined query gives the same three answers.
+        const Vec2 u = dir(where);
+        const double spread = U(rng);
+        const NormalCone::Facing f = c.facing(from, to, u, spread);
+        CHECK(f.all == every);
+        CHECK(f.none == no);
+        CHECK(f.departure == c.linear_departure(u, spread));
         all_seen += every ? 1 : 0;
         none_seen += no ? 1 : 0;
     }
