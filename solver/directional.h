@@ -73,6 +73,14 @@ inline BinWeight bin_of(Vec2 u) {
     return {k, t};
 }
 
+/// Where the opposite direction -u falls, given where u falls: half the
+/// table further on, with the same weight (one atan2 per link instead of
+/// two).
+inline BinWeight opposite(BinWeight b) {
+    static_assert(directional_bins % 2 == 0, "the opposite of a sample is a sample");
+    return {(b.k + directional_bins / 2) % directional_bins, b.t};
+}
+
 /// Unit directions of the samples.
 inline const std::array<Vec2, directional_bins>& bin_directions() {
     static const std::array<Vec2, directional_bins> dirs = [] {

@@ -648,7 +648,7 @@ bool HierarchicalSolver::make_link(int r, int s, Link& l, VisibilityStats& st) c
         return true;
     }
     const Vec2 u = d / dist;  // from s to r
-    const BinWeight sbin = bin_of(u), rbin = bin_of(-u);
+    const BinWeight sbin = bin_of(u), rbin = opposite(sbin);
     l.sk = static_cast<uint8_t>(sbin.k);
     l.st = static_cast<float>(sbin.t);
     l.rk = static_cast<uint8_t>(rbin.k);
@@ -1366,17 +1366,18 @@ void HierarchicalSolver::reach() {
     // from what a receiver got, so every node has two vertices: k receiving
     // (reached by a link or a push) and N + k sending (reached by a pull);
     // only links lead from a sending vertex to a receiving one.
-    std::vector<std::pair<int, int>> flow;
+    std::vector<DirectedEdge> flow;
     flow.reserve(3 * m_nodes.size() + m_links.size());
+    auto edge = [](int a, int b) { return DirectedEdge{static_cast<uint32_t>(a), static_cast<uint32_t>(b)}; };
     for (int k = 0; k < N; ++k) {
-        const Node& n = m_nodes[static_cast<size_t>(k)];
-        if (n.kind == Kind::Element) flow.push_back({k, N + k});  // a lit element sends what it holds
+        const OpNode& n = m_op[static_cast<size_t>(k)];
+        if (n.kind == Kind::Element) flow.push_back(edge(k, N + k));  // a lit element sends what it holds
         if (n.parent >= 0) {
-            flow.push_back({n.parent, k});  // push down
-            if (n.kind != Kind::Sink) flow.push_back({N + k, N + n.parent});  // pull up
+            flow.push_back(edge(n.parent, k));  // push down
+            if (n.kind != Kind::Sink) flow.push_back(edge(N + k, N + n.parent));  // pull up
         }
     }
-    for (const Link& l : m_links) flow.push_back({N + l.s, l.r});
+    for (const Link& l : m_links) flow.push_back(edge(N + l.s, l.r));
     std::vector<char> src2(2 * static_cast<size_t>(N), 0);
     for (int k = 0; k < N; ++k) src2[static_cast<size_t>(k)] = sources[static_cast<size_t>(k)];
     const std::vector<char> reached2 = reachable_directed(2 * N, flow, src2);

@@ -5,14 +5,11 @@
 
 namespace flatrad {
 
-std::vector<char> reachable_directed(int vertices, const std::vector<std::pair<int, int>>& edges,
+std::vector<char> reachable_directed(int vertices, const std::vector<DirectedEdge>& edges,
                                      const std::vector<char>& sources) {
     using Graph = boost::compressed_sparse_row_graph<boost::directedS, boost::no_property, boost::no_property,
                                                      boost::no_property, uint32_t, uint32_t>;
-    std::vector<std::pair<uint32_t, uint32_t>> e;
-    e.reserve(edges.size());
-    for (const auto& [a, b] : edges) e.push_back({static_cast<uint32_t>(a), static_cast<uint32_t>(b)});
-    const Graph graph(boost::edges_are_unsorted_multi_pass, e.begin(), e.end(), static_cast<uint32_t>(vertices));
+    const Graph graph(boost::edges_are_unsorted_multi_pass, edges.begin(), edges.end(), static_cast<uint32_t>(vertices));
     std::vector<boost::default_color_type> color(static_cast<size_t>(vertices), boost::white_color);
     auto color_map = boost::make_iterator_property_map(color.begin(), boost::get(boost::vertex_index, graph));
     boost::queue<uint32_t> queue;

@@ -7,9 +7,10 @@
 /// from sender to receiver, receivers push down to their children. Light
 /// reaches exactly the vertices reachable from the emitters (a
 /// breadth-first search from all of them, Boost.Graph on a compressed
-/// sparse row graph: two int32 per edge, for millions of links). The caller
+/// sparse row graph: two uint32 per edge, for millions of links). The caller
 /// passes only edges that may carry light, so what is left out truly
 /// receives nothing.
+#include <cstdint>
 #include <utility>
 #include <vector>
 
@@ -17,7 +18,8 @@ namespace flatrad {
 
 /// `edges` (from, to) over vertices [0, vertices); `sources[v]` says whether
 /// v starts lit. Returns, per vertex, whether light from a source reaches it.
-std::vector<char> reachable_directed(int vertices, const std::vector<std::pair<int, int>>& edges,
+using DirectedEdge = std::pair<uint32_t, uint32_t>;
+std::vector<char> reachable_directed(int vertices, const std::vector<DirectedEdge>& edges,
                                      const std::vector<char>& sources);
 
 }  // namespace flatrad

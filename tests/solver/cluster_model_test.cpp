@@ -254,3 +254,20 @@ TEST_CASE("directional tables: facing u only, the table leaves its linear part o
     CHECK(tightest > 0.5);
     CHECK(checked > 10000);
 }
+
+TEST_CASE("directional tables: the opposite direction's bin is half the table on, with the same weight") {
+    // bin_of(-u) computed by atan2 agrees with opposite(bin_of(u)) to the
+    // rounding of an angle of size ~2 pi, divided by the step (~1e-15 in t).
+    constexpr double tol = 1e-12;
+    std::mt19937 rng(31);
+    std::uniform_real_distribution<double> U(0, 2 * std::numbers::pi);
+    for (int q = 0; q < 2000; ++q) {
+        const double a = U(rng);
+        const Vec2 u{std::cos(a), std::sin(a)};
+        const BinWeight o = opposite(bin_of(u)), b = bin_of(-u);
+        // The same point of the circle: k + t equal modulo the table.
+        double d = (o.k + o.t) - (b.k + b.t);
+        d -= directional_bins * std::round(d / directional_bins);
+        CHECK(std::abs(d) <= tol);
+    }
+}

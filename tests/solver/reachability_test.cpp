@@ -14,7 +14,7 @@ using namespace flatrad;
 
 TEST_CASE("reachability: what a breadth-first search from the sources reaches, along edge directions") {
     // 0 -> 1 -> 2, 3 -> 0 (3 not reached from 0), 4 alone, 5 -> 6; sources 0 and 5.
-    const std::vector<std::pair<int, int>> edges{{0, 1}, {1, 2}, {3, 0}, {5, 6}};
+    const std::vector<DirectedEdge> edges{{0, 1}, {1, 2}, {3, 0}, {5, 6}};
     const std::vector<char> r = reachable_directed(7, edges, {1, 0, 0, 0, 0, 1, 0});
     CHECK(r == std::vector<char>{1, 1, 1, 0, 0, 1, 1});
     CHECK(reachable_directed(3, {}, {0, 0, 0}) == std::vector<char>{0, 0, 0});
