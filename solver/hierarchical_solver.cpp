@@ -267,6 +267,9 @@ private:
     void push_down(TableArray& tables, const std::vector<double>& own, double lobe_scale,
                    std::vector<double>& above, const Part* part = nullptr) const;
 
+    // First: stats.time_s counts the set-up below (hierarchy, connectivity,
+    // rooms, sinks) as well as the run.
+    Clock::time_point m_t_start = Clock::now();
     const Scene& m_scene;
     HierarchicalOptions m_opt;
     int m_C;
@@ -295,6 +298,7 @@ private:
     std::vector<Link> m_links;
     std::vector<Link> m_links_sorted, m_fresh;  // scratch of sort_links and refine, kept for their pages
     size_t m_sorted_links = 0;  // how many of m_links, from the first, are sorted by receiver
+    std::vector<char> m_refine_decision;  // refine's decisions on its tail of links
     std::vector<int32_t> m_link_start;   // CSR by receiver (after sort_links)
     std::vector<int32_t> m_receivers;
     std::vector<int> m_leaves;           // element leaves
@@ -432,6 +436,16 @@ void HierarchicalSolver::build_tree() {
         int hnode, node;
     };
     std::vector<Pending> queue;
+    queue.reserve(hn.size());
+    // Room for every cluster and side, and as many element halves again:
+    // reserved address space (pages count only once written), so that
+    // millions of nodes are neither copied nor zeroed twice as they grow.
+    size_t sides = 0;
+    for (size_t s = 0; s < m_scene.segments.size(); ++s)
+        for (int side = 0; side < 2; ++side)
+            sides += (side == 0 ? m_scene.segments[s].lit_left : m_scene.segments[s].lit_right) ||
+                     m_visible_sink[2 * s + static_cast<size_t>(side)];
+    m_nodes.reserve(hn.size() + 2 * sides);
     m_nodes.push_back({});
     m_root = 0;
     queue.push_back({m_hierarchy.root(), 0});
@@ -1128,19 +1142,31 @@ bool HierarchicalSolver::refine(const std::vector<double>& leaf_bmax) {
     const double eps_abs = m_opt.eps * W.value() / std::max(1L, patches);
     if (!(eps_abs > 0)) return false;
 
-    std::vector<int> work(m_links.size());
-    for (size_t k = 0; k < work.size(); ++k) work[k] = static_cast<int>(k);
-    bool any = false;
-    std::vector<char> decision;
-    std::vector<char> dead(m_links.size(), 0);
-    while (!work.empty()) {
+    // The first round starts from one link: room for 16 per segment (round
+    // rooms keep 9 to 14), reserved address space as for the nodes
+    // (build_tree); beyond it the links grow as usual. (Later rounds keep
+    // the capacity sort_links left.)
+    const size_t expected = 16 * m_scene.segments.size() + 1024;
+    if (m_links.size() <= 1 && m_links.capacity() < expected) m_links.reserve(expected);
+    // The links still to decide are always the tail m_links[tail, end):
+    // every link at first, then the children made by the last wave. After
+    // each wave the tail drops what was split or dropped (in order, so the
+    // survivors of sort_links' sorted prefix stay sorted) before the
+    // children are appended: links never pile up dead (a round room of 10^6
+    // walls makes twice as many links as it keeps).
+    std::vector<char>& decision = m_refine_decision;  // kept between rounds: its pages are written once
+    size_t tail = 0;
+    const size_t prefix = std::min(m_sorted_links, m_links.size());
+    m_sorted_links = 0;  // set by the first wave, which holds the whole prefix
+    bool first_wave = true, any = false;
+    while (tail < m_links.size()) {
         // 1. Decide, in parallel.
         // A link whose visibility is pending is split on its geometry alone
         // when that exceeds eps_abs (a lower bound of its error whatever the
         // visibility is); only the others ask the visibility module (most
         // links of an occluded scene are split anyway).
-        decision.assign(work.size(), 0);
-        const long nw = static_cast<long>(work.size());
+        const long nw = static_cast<long>(m_links.size() - tail);
+        decision.assign(static_cast<size_t>(nw), 0);
         const auto t_decide = Clock::now();
         long resolved = 0;
 #pragma omp parallel num_threads(m_threads) if (nw > parallel_min_work)
@@ -1150,7 +1176,7 @@ bool HierarchicalSolver::refine(const std::vector<double>& leaf_bmax) {
             long asked = 0;
 #pragma omp for schedule(dynamic, 64)
             for (long k = 0; k < nw; ++k) {
-                Link& l = m_links[static_cast<size_t>(work[static_cast<size_t>(k)])];
+                Link& l = m_links[tail + static_cast<size_t>(k)];
                 const Node& r = m_nodes[static_cast<size_t>(l.r)];
                 const Node& s = m_nodes[static_cast<size_t>(l.s)];
                 if (l.r == l.s) {
@@ -1186,13 +1212,19 @@ bool HierarchicalSolver::refine(const std::vector<double>& leaf_bmax) {
             }
         }
         if (resolved > 0) m_ff_time += seconds_since(t_decide);
-        // 2. Split (serially: creates nodes), collecting the children links.
+        // 2. Split (serially: creates nodes), collecting the children links,
+        // and keep the tail's survivors in place.
         std::vector<Link>& fresh = m_fresh;
         fresh.clear();
-        for (size_t k = 0; k < work.size(); ++k) {
-            if (!decision[k]) continue;
-            const Link l = m_links[static_cast<size_t>(work[k])];
-            dead[static_cast<size_t>(work[k])] = 1;
+        size_t w = tail;
+        for (size_t k = 0; k < static_cast<size_t>(nw); ++k) {
+            const size_t at = tail + k;
+            if (first_wave && at == prefix) m_sorted_links = w;
+            if (!decision[k]) {
+                m_links[w++] = m_links[at];
+                continue;
+            }
+            const Link l = m_links[at];
             if (decision[k] == 4) continue;  // dropped, not split
             any = true;
             if (decision[k] == 3) {
@@ -1207,27 +1239,15 @@ bool HierarchicalSolver::refine(const std::vector<double>& leaf_bmax) {
             }
             children_links(l, split_r, fresh);
         }
-        if (fresh.empty()) break;
+        if (first_wave && prefix >= static_cast<size_t>(nw)) m_sorted_links = w;  // the whole prefix survived in order
+        first_wave = false;
+        m_links.resize(w);
+        tail = w;
         // 3. Coefficients of the new links (in parallel), then append them.
         compute_links(fresh);
-        work.clear();
-        for (const Link& l : fresh) {
-            work.push_back(static_cast<int>(m_links.size()));
-            m_links.push_back(l);
-            dead.push_back(0);
-        }
-        progress(fmt::format("refining: {} links", m_links.size()), -1);
+        m_links.insert(m_links.end(), fresh.begin(), fresh.end());
+        if (!fresh.empty()) progress(fmt::format("refining: {} links", m_links.size()), -1);
     }
-    // Compact, keeping the order: the survivors of the sorted prefix stay
-    // sorted (sort_links merges the rest in).
-    size_t w = 0;
-    const size_t prefix = m_sorted_links;
-    for (size_t k = 0; k < m_links.size(); ++k) {
-        if (k == prefix) m_sorted_links = w;
-        if (!dead[k]) m_links[w++] = m_links[k];
-    }
-    if (prefix >= m_links.size()) m_sorted_links = w;
-    m_links.resize(w);
     return any;
 }
 
@@ -1712,7 +1732,6 @@ std::vector<double> HierarchicalSolver::landed_fraction() const {
 }
 
 Solution HierarchicalSolver::run() {
-    const auto t_start = Clock::now();
     refuse_closed_white();
     build_tree();
     collect_leaves();
@@ -1810,7 +1829,7 @@ Solution HierarchicalSolver::run() {
     sol.stats.residual = m_residual;
     sol.stats.threads = m_threads;
     sol.stats.visibility = m_stats;
-    sol.stats.time_s = seconds_since(t_start);
+    sol.stats.time_s = seconds_since(m_t_start);
     return sol;
 }
 
