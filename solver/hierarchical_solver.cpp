@@ -63,6 +63,13 @@ constexpr size_t min_pieces_to_approximate = 512;
 // 1 / (1 - rho) = 1000 (white furnace 0.999).
 constexpr double gmres_tolerance = 1e-12;
 
+// The bound of an element link's kernel variation
+// (HierarchicalSolver::kernel_variation): each |F_q - F / 4| <= F_q + F / 4, and the quarters' F_q sum
+// to F (the same F from r; reciprocity for r's quarters, 4 F in all), so
+// both sums are at most 2 F. The margin covers rounding of the crossed
+// strings (1e-15 relative) with room to spare.
+double kernel_variation_bound(double Fu) { return 2 * Fu * (1 + 1e-6); }
+
 enum class Kind : uint8_t {
     Cluster,  // a node of the scene's cluster hierarchy
     Element,  // a patch (lit side of a segment) or a piece of one
@@ -150,6 +157,9 @@ struct Link {
     // its linear part there, relative to the linear part's norm (0 when
     // every member faces every direction of the spread).
     bool s_linear = false, r_linear = false;
+    // Element links: kvar is kernel_variation itself, or (false) its bound
+    // 2 Fu, until a decision needs the exact value (refine).
+    bool kvar_exact = true;
     double coef = 0;
     float tau = 1;            // transmittance (cluster links), F / F_unoccluded (element links)
     float vis_err = 0;        // visibility bound: on tau (cluster links) or on F (element links)
@@ -623,7 +633,11 @@ bool HierarchicalSolver::make_link(int r, int s, Link& l, VisibilityStats& st) c
         }
         l.coef = Fu;
         l.Fu = static_cast<float>(Fu);
-        l.kvar = static_cast<float>(kernel_variation(nr, ns, l.Fu));
+        // The kernel's variation costs eight crossed strings; most element
+        // links are kept whatever it is, so it starts as its bound
+        // (kernel_variation) and is computed when a decision needs it.
+        l.kvar = static_cast<float>(kernel_variation_bound(l.Fu));
+        l.kvar_exact = false;
         if (!m_unblockable && !l.clear) {
             // Visibility is asked later, if the link survives its geometry
             // (refine; resolve_visibility).
@@ -946,10 +960,11 @@ LinkError HierarchicalSolver::link_error(const Link& l, const std::vector<double
         const double power = Bn[static_cast<size_t>(l.s)] * r.length;
         if (!(power > 0)) return {};
         // Kernel variation over quarters of each side: catches ends-vs-
-        // middle variation that halves miss by symmetry.
-        // (computed once, with the link: kernel_variation).
+        // middle variation that halves miss by symmetry (kernel_variation,
+        // or its bound until refine needs it exact).
         const double kvar = l.kvar;
-        // Geometry alone (visibility not asked yet): a lower bound.
+        // Geometry alone (visibility not asked yet): a lower bound (with
+        // the kernel variation exact).
         if (geometry_only) return {power * kvar, size_r >= size_s};
         // A partly hidden sender may put a shadow boundary anywhere on the
         // receiver; a sink absorbs all it gets, wherever on it, so there
@@ -1185,9 +1200,22 @@ bool HierarchicalSolver::refine(const std::vector<double>& leaf_bmax) {
                 }
                 const bool can_r = r.cluster() || (r.kind == Kind::Element && r.depth < m_opt.max_depth);
                 const bool can_s = s.cluster() || (s.kind == Kind::Element && s.depth < m_opt.max_depth);
+                // The error with an element link's kernel variation still at
+                // its bound is an upper bound of the error with it exact:
+                // the exact one is computed only where the bound would split
+                // (the same decisions as computing it with the link).
+                auto error = [&](bool geometry_only) {
+                    LinkError e = link_error(l, Bn, I, geometry_only);
+                    if (e.err > eps_abs && !l.kvar_exact) {
+                        l.kvar = static_cast<float>(kernel_variation(r, s, l.Fu));
+                        l.kvar_exact = true;
+                        e = link_error(l, Bn, I, geometry_only);
+                    }
+                    return e;
+                };
                 if (l.vis_pending) {
                     if (can_r || can_s) {
-                        const LinkError g = link_error(l, Bn, I, true);
+                        const LinkError g = error(true);
                         if (g.err > eps_abs) {
                             decision[static_cast<size_t>(k)] = can_r && (!can_s || g.split_r) ? 1 : 2;
                             continue;
@@ -1200,7 +1228,7 @@ bool HierarchicalSolver::refine(const std::vector<double>& leaf_bmax) {
                     }
                 }
                 if (!can_r && !can_s) continue;
-                const LinkError e = link_error(l, Bn, I);
+                const LinkError e = error(false);
                 if (e.err <= eps_abs) continue;
                 const bool split_r = can_r && (!can_s || e.split_r);
                 decision[static_cast<size_t>(k)] = split_r ? 1 : 2;
