@@ -190,6 +190,9 @@ struct LinkError {
 // into m_leaves); its receivers (indices into m_receivers).
 struct Part {
     std::vector<int> nodes, leaves, receivers;
+    // The whole scene as one part: every node, leaf and receiver, without
+    // lists (the operator runs unrestricted; leaves lists every leaf).
+    bool whole = false;
 };
 
 using Clock = std::chrono::steady_clock;
@@ -317,6 +320,10 @@ private:
     std::vector<OpNode> m_op;            // per node (collect_leaves)
     std::vector<char> m_reached;         // per node
     long m_left_out = 0;
+    long m_dark_links = 0;               // links the last reach() dropped
+    // The last flow check (reach, parts) found nothing dark and one part;
+    // whether the last solve made that check (solve).
+    bool m_flow_simple = false, m_flow_checked = false;
     // Row sums (see the header): per leaf, the deficit 1 - (sum of what its
     // own and its ancestors' links deliver for B = 1 everywhere), and the
     // ancestors' part of that sum; 0 for leaves not known to be closed.
@@ -1437,9 +1444,11 @@ void HierarchicalSolver::reach() {
         if (m_reached[static_cast<size_t>(leaf)]) lit_patch[static_cast<size_t>(m_nodes[static_cast<size_t>(leaf)].patch)] = 1;
     m_left_out = 0;
     for (char c : lit_patch) m_left_out += c ? 0 : 1;
+    const size_t before = m_links.size();
     m_links.erase(std::remove_if(m_links.begin(), m_links.end(),
                                  [&](const Link& l) { return !reached2[static_cast<size_t>(N + l.s)]; }),
                   m_links.end());
+    m_dark_links = static_cast<long>(before - m_links.size());
     m_sorted_links = std::min(m_sorted_links, m_links.size());  // remove_if keeps the order
 }
 
@@ -1555,9 +1564,30 @@ void HierarchicalSolver::solve() {
             m_own_sum[static_cast<size_t>(i)] = m_Hn[static_cast<size_t>(node)];
         }
     }
-    reach();  // drops links, keeping the order: still sorted by receiver
-    index_receivers();  // (the slots above still hold every table a link uses)
-    build_parts();
+    // Light flow and independent parts. Refinement only splits links
+    // (each child joins nodes below the ends of its parent), so what light
+    // reaches can only shrink and parts only come apart: when the last
+    // check found every patch reached, no link dark and one part, the next
+    // solves skip the check (what it would drop carries no light, and one
+    // part solves everything together); run() checks once more at the end
+    // for the stats. A round room of 10^6 walls spent ~1 s per round here.
+    if (!m_solved || !m_flow_simple) {
+        reach();  // drops links, keeping the order: still sorted by receiver
+        index_receivers();  // (the slots above still hold every table a link uses)
+        build_parts();
+        m_flow_simple = m_left_out == 0 && m_dark_links == 0 && m_parts.size() == 1;
+        m_flow_checked = true;
+    } else {
+        m_flow_checked = false;
+    }
+    if (m_flow_simple) {
+        // One part: the operator unrestricted (no lists to walk).
+        m_parts.assign(1, Part{});
+        Part& all = m_parts[0];
+        all.whole = true;
+        all.leaves.resize(static_cast<size_t>(n));
+        for (Eigen::Index i = 0; i < n; ++i) all.leaves[static_cast<size_t>(i)] = static_cast<int>(i);
+    }
     // Krylov runs start from the previous round's solution (a new half
     // from the element it halves): a refinement round changes few links,
     // so the next solve has little left to do. The first starts from E.
@@ -1592,7 +1622,7 @@ void HierarchicalSolver::solve() {
             }
             auto apply = [&](const Eigen::VectorXd& v) -> Eigen::VectorXd {
                 for (Eigen::Index j = 0; j < m; ++j) full(part.leaves[static_cast<size_t>(j)]) = v(j);
-                apply_G(full, g, true, &part);
+                apply_G(full, g, true, part.whole ? nullptr : &part);
                 Eigen::VectorXd out(m);
                 for (Eigen::Index j = 0; j < m; ++j) {
                     const Eigen::Index i = part.leaves[static_cast<size_t>(j)];
@@ -1783,6 +1813,14 @@ Solution HierarchicalSolver::run() {
             progress(fmt::format("refining (pass {})", pass + 1), -1);
             if (!refine(bmax)) break;
             solve();
+        }
+        if (!m_flow_checked) {
+            // The last solves skipped the flow check (solve): make it for
+            // the stats. The links it drops carry no light, so the solution
+            // stands.
+            reach();
+            index_receivers();
+            build_parts();
         }
     } else {
         collect_leaves();  // nothing emits: B = 0 everywhere, no link needed
