@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <future>
 #include <limits>
 #include <mutex>
 #include <numbers>
@@ -194,6 +195,25 @@ struct LinkError {
 // An independent sub-scene (solver/light_parts.h): the nodes its light
 // moves through, ascending (parents first); its element leaves (indices
 // into m_leaves); its receivers (indices into m_receivers).
+// What the scene's connectivity says (engine/connectivity.h, solver/rooms.h,
+// solver/sink_visibility.h): computed beside the hierarchy (see
+// HierarchicalSolver's members).
+struct SceneFacts {
+    Connectivity conn;
+    std::vector<char> escape_free;   // per patch
+    std::vector<char> visible_sink;  // per segment side
+    std::vector<int> side_room;      // per segment side
+};
+
+SceneFacts scene_facts(const Scene& scene) {
+    SceneFacts f;
+    f.conn = scene_connectivity(scene);
+    f.escape_free = escape_free_patches(scene, f.conn);
+    f.visible_sink = visible_sinks(scene, f.conn);
+    f.side_room = side_rooms(scene, f.conn);
+    return f;
+}
+
 struct Part {
     std::vector<int> nodes, leaves, receivers;
     // The whole scene as one part: every node, leaf and receiver, without
@@ -210,6 +230,7 @@ public:
         : m_scene(scene),
           m_opt(o),
           m_C(scene.channels),
+          m_facts(std::async(std::launch::async, scene_facts, std::cref(scene))),
           m_hierarchy(scene.segment_geometry(), 1),
           m_tables(m_hierarchy),
           m_vis(m_hierarchy, m_tables),
@@ -223,11 +244,11 @@ public:
         const std::vector<char> blockers = possible_blockers(scene);
         m_hierarchy.set_blockers(blockers);
         m_unblockable = std::find(blockers.begin(), blockers.end(), 1) == blockers.end();
-        const Connectivity conn = scene_connectivity(scene);
-        m_escape_free = escape_free_patches(scene, conn);
-        m_visible_sink = visible_sinks(scene, conn);
-        m_side_room = side_rooms(scene, conn);
-        convex_object_skips(conn);
+        SceneFacts facts = m_facts.get();
+        m_escape_free = std::move(facts.escape_free);
+        m_visible_sink = std::move(facts.visible_sink);
+        m_side_room = std::move(facts.side_room);
+        convex_object_skips(facts.conn);
         const bool sinks = std::find(m_visible_sink.begin(), m_visible_sink.end(), 1) != m_visible_sink.end();
         // Row sums of 1 hold for escape-free patches when no sink can be seen.
         m_closed_patch.assign(scene.patches.size(), 0);
@@ -292,6 +313,10 @@ private:
     const Scene& m_scene;
     HierarchicalOptions m_opt;
     int m_C;
+    // The connectivity's facts, computed on a second thread while the
+    // hierarchy is built (declared before it, so started first): at 10^6
+    // walls 1.5 s against the hierarchy's and the hull's 0.9 s.
+    std::future<SceneFacts> m_facts;
     int m_threads = 1;
     double m_vis_eps = 0;
     bool m_unblockable = false;
