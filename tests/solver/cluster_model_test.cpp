@@ -8,6 +8,7 @@
 #include <numbers>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "engine/connectivity.h"
 #include "engine/normal_cone.h"
@@ -17,6 +18,32 @@
 #include "solver/sink_visibility.h"
 
 using namespace flatrad;
+
+namespace {
+
+// A few cosine lobes (weights 0.1 .. 1.1) with normals spread over an arc of
+// up to 3 radians around a random direction, added to a table, and the
+// normal cone that holds them.
+struct RandomLobes {
+    double table[directional_table_width] = {};
+    std::vector<std::pair<Vec2, double>> lobes;
+    NormalCone cone;
+};
+
+RandomLobes random_lobes(std::mt19937& rng) {
+    std::uniform_real_distribution<double> U(0, 1);
+    RandomLobes r;
+    const double mid = 2 * std::numbers::pi * U(rng), width = 3.0 * U(rng);
+    for (int k = 0; k < 1 + static_cast<int>(U(rng) * 9); ++k) {
+        const double a = mid + width * (U(rng) - 0.5);
+        r.lobes.push_back({{std::cos(a), std::sin(a)}, 0.1 + U(rng)});
+        add_cosine_lobe(r.table, r.lobes.back().first, r.lobes.back().second);
+        r.cone = NormalCone::merge(r.cone, NormalCone::of(r.lobes.back().first));
+    }
+    return r;
+}
+
+}  // namespace
 
 TEST_CASE("directional tables: exact at the samples, interpolation error within its estimate") {
     // Rounding in a sum of a few cosines.
@@ -168,16 +195,10 @@ TEST_CASE("directional tables: the linear part is exact wherever every lobe face
     std::uniform_real_distribution<double> U(0, 1);
     int facing = 0;
     for (int trial = 0; trial < 200; ++trial) {
-        const double mid = 2 * std::numbers::pi * U(rng), width = 3.0 * U(rng);
-        double table[directional_table_width] = {};
-        std::vector<std::pair<Vec2, double>> lobes;
-        NormalCone cone;
-        for (int k = 0; k < 1 + static_cast<int>(U(rng) * 9); ++k) {
-            const double a = mid + width * (U(rng) - 0.5);
-            lobes.push_back({{std::cos(a), std::sin(a)}, 0.1 + U(rng)});
-            add_cosine_lobe(table, lobes.back().first, lobes.back().second);
-            cone = NormalCone::merge(cone, NormalCone::of(lobes.back().first));
-        }
+        const RandomLobes r = random_lobes(rng);
+        const double* table = r.table;
+        const auto& lobes = r.lobes;
+        const NormalCone& cone = r.cone;
         for (int q = 0; q < 20; ++q) {
             const double a = 2 * std::numbers::pi * U(rng);
             const Vec2 u{std::cos(a), std::sin(a)};
@@ -208,16 +229,10 @@ TEST_CASE("directional tables: facing u only, the table leaves its linear part o
     int departed = 0, checked = 0;
     double tightest = 0;  // the largest share of the bound reached
     for (int trial = 0; trial < 300; ++trial) {
-        const double mid = 2 * std::numbers::pi * U(rng), width = 3.0 * U(rng);
-        double table[directional_table_width] = {};
-        std::vector<std::pair<Vec2, double>> lobes;
-        NormalCone cone;
-        for (int k = 0; k < 1 + static_cast<int>(U(rng) * 9); ++k) {
-            const double a = mid + width * (U(rng) - 0.5);
-            lobes.push_back({{std::cos(a), std::sin(a)}, 0.1 + U(rng)});
-            add_cosine_lobe(table, lobes.back().first, lobes.back().second);
-            cone = NormalCone::merge(cone, NormalCone::of(lobes.back().first));
-        }
+        const RandomLobes r = random_lobes(rng);
+        const double* table = r.table;
+        const auto& lobes = r.lobes;
+        const NormalCone& cone = r.cone;
         auto exact = [&](Vec2 u) {
             double s = 0;
             for (const auto& [n, w] : lobes) s += w * std::max(0.0, dot(n, u));
