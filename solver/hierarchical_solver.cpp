@@ -1187,7 +1187,7 @@ bool HierarchicalSolver::refine(const std::vector<double>& leaf_bmax) {
     // table array per round was hundreds of MB of new pages at 10^6 walls.
     std::vector<double>& Bn = m_Bn;
     TableArray& I = m_I;
-    I.reset_full(m_tables_count);  // new links may read any table's samples
+    I.reset_full(m_tables_count);  // new links may read any table's samples (pull_tables zeroes them)
     pull_tables(leaf_bmax.data(), Bn, I);
     // eps_abs = eps * W / N (see the header).
     CompensatedSum W;
@@ -1464,6 +1464,8 @@ void HierarchicalSolver::sample_slots() {
     m_J_slotted = slots(need_J, m_J_slot);
     m_I.reset(m_I_slot, m_I_slotted);
     m_J.reset(m_J_slot, m_J_slotted);
+    m_I.clear();  // a part's operator zeroes only its own tables
+    m_J.clear();
 }
 
 // Light flow (solver/reachability.h): which element leaves and sinks any
@@ -1834,6 +1836,7 @@ std::vector<double> HierarchicalSolver::landed_fraction() const {
     std::vector<double> own(N, 0.0);
     TableArray lam;  // the adjoint has samples where the links read I's (the same slots)
     lam.reset(m_I_slot, m_I_slotted);
+    lam.clear();
     for (const Link& l : m_links) {
         const Node& r = m_nodes[static_cast<size_t>(l.r)];
         const Node& s = m_nodes[static_cast<size_t>(l.s)];

@@ -24,15 +24,19 @@ namespace flatrad {
 
 class TableArray {
 public:
-    /// `tables` tables, every one with samples; all zero.
+    /// Layouts. Contents are left unspecified (clear() before use): every
+    /// user zeroes its tables at the start of a pass anyway, and zeroing
+    /// here too was a second pass over hundreds of MB per round at 10^6
+    /// walls.
+    /// `tables` tables, every one with samples.
     void reset_full(int tables) {
         m_slot = nullptr;
         assign(tables, tables);
     }
 
     /// `tables` tables, table t with samples at slot[t] >= 0 (slots 0 ..
-    /// slotted - 1), none where slot[t] < 0; all zero. `slot` must outlive
-    /// its use here.
+    /// slotted - 1), none where slot[t] < 0. `slot` must outlive its use
+    /// here.
     void reset(const std::vector<int32_t>& slot, int slotted) {
         m_slot = &slot;
         assign(static_cast<int>(slot.size()), slotted);
@@ -88,8 +92,8 @@ private:
     int32_t slot(int t) const { return m_slot ? (*m_slot)[static_cast<size_t>(t)] : t; }
     void assign(int tables, int slotted) {
         m_tables = tables;
-        m_linear.assign(2 * static_cast<size_t>(tables), 0.0);
-        m_samples.assign(static_cast<size_t>(slotted) * directional_bins, 0.0);
+        m_linear.resize(2 * static_cast<size_t>(tables));
+        m_samples.resize(static_cast<size_t>(slotted) * directional_bins);
     }
 
     const std::vector<int32_t>* m_slot = nullptr;  // null: table t has slot t
