@@ -109,6 +109,10 @@ struct HierarchicalOptions {
     /// Solve independent sub-scenes apart (solver/light_parts.h); off: one
     /// Krylov run over everything (the same solution, for tests).
     bool solve_parts_apart = true;
+    /// A closed convex room whose patches all reflect or emit is one part
+    /// with every patch reached, without the light-flow check (proof in
+    /// solve()); off: checked like any scene (the same solution, for tests).
+    bool convex_room_shortcut = true;
     /// Called now and then from the solving thread with what is being done
     /// ("refine pass 2", "solve", ...) and a fraction in [0, 1] of the whole
     /// run when one is known (< 0 otherwise). Empty: no reports. The CLI

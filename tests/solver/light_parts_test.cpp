@@ -91,3 +91,42 @@ TEST_CASE("hierarchical solver: independent rooms are solved apart, to the same 
                   same_solution_tol * t.totals.absorbed[static_cast<size_t>(c)]);
     }
 }
+
+TEST_CASE("hierarchical solver: a convex room skips the light-flow check, with what the check would find") {
+    // Closed convex rooms (every wall on the hull, every patch escape-free,
+    // every patch reflecting in some channel): the first one has a wall on
+    // the lamp's own line (reached only by reflection), the second is a
+    // round room with the lamp among its walls and a channel that only some
+    // walls reflect.
+    const std::string collinear = R"({"flatrad": 1, "materials": {"w": {"reflectance": [0.6, 0.2, 0.05]},
+        "lamp": {"emission": [1, 0.5, 2], "reflectance": 0.1}}, "surfaces": [
+        {"name": "lamp", "material": "lamp", "points": [[0,0],[1,0]], "side": "left"},
+        {"name": "walls", "material": "w", "points": [[1,0],[1.5,0],[2,0.5],[2,2],[0.5,2.5],[-0.5,1],[0,0]], "side": "left"}]})";
+    const std::string round = R"({"flatrad": 1, "materials": {"w": {"reflectance": [0.5, 0, 0.7]},
+        "v": {"reflectance": [0.5, 0.8, 0]}, "l": {"reflectance": 0.5, "emission": [1, 2, 3]}}, "surfaces": [
+        {"name": "arc", "material": "w", "side": "left", "points": [[1,0],[0.7071,0.7071],[0,1],[-0.7071,0.7071],[-1,0]]},
+        {"name": "lamp", "material": "l", "side": "left", "points": [[-1,0],[-0.7071,-0.7071]]},
+        {"name": "rest", "material": "v", "side": "left", "points": [[-0.7071,-0.7071],[0,-1],[0.7071,-0.7071],[1,0]]}]})";
+    for (const std::string& text : {collinear, round}) {
+        const Scene scene = parse_scene(text, "convex.json");
+        for (double eps : {1e-2, 1e-4}) {
+            HierarchicalOptions shortcut, checked;
+            shortcut.eps = checked.eps = eps;
+            checked.convex_room_shortcut = false;
+            const Solution a = solve_hierarchical(scene, shortcut);
+            const Solution b = solve_hierarchical(scene, checked);
+            CAPTURE(scene.name);
+            CAPTURE(eps);
+            CHECK(b.stats.patches_left_out == 0);
+            CHECK(b.stats.independent_parts == 1);
+            CHECK(a.stats.patches_left_out == b.stats.patches_left_out);
+            CHECK(a.stats.independent_parts == b.stats.independent_parts);
+            CHECK(a.stats.links == b.stats.links);
+            // With nothing dark and one part, both runs apply the same
+            // unrestricted operator in the same order, and a convex room asks
+            // no visibility (no thread-order effect): the same bits.
+            for (size_t p = 0; p < scene.patches.size(); ++p)
+                CHECK(a.patches[p].radiosity == b.patches[p].radiosity);
+        }
+    }
+}
