@@ -94,6 +94,10 @@ struct alignas(64) Node {
     Kind kind = Kind::Cluster;
     bool leaf_cluster = false;  // a hierarchy leaf: its children are its segments' sides
     bool can_send = false;      // some patch below reflects or emits
+    // An arc of one convex loop (mark_chains): an element lit on the room's
+    // side of a convex loop's wall, or a cluster whose sides are all such
+    // elements, of contiguous walls of one loop (its length is then theirs).
+    bool chain = false;
     int16_t depth = 0;          // elements: level below the patch
     int32_t table = -1;         // clusters: index of the directional tables
     int32_t hnode = -1;         // hierarchy node (clusters; elements: their segment's leaf)
@@ -135,6 +139,7 @@ struct OpNode {
     Kind kind = Kind::Cluster;
     bool leaf_cluster = false;
     bool side = false;      // an element or sink right under a leaf cluster
+    bool chain = false;     // Node::chain (a chain cluster's length is its elements')
     Vec2 normal;            // elements and sinks
     double length = 0;      // elements and sinks
 };
@@ -157,9 +162,14 @@ struct Link {
     // BinWeight, packed: a link is 64 bytes, and there are 10^7 of them at
     // 10^6 walls; a float weight rounds the interpolation by ~1e-7, the
     // same rounding for the operator and its adjoint).
-    float st = 0, rt = 0;
-    uint8_t sk = 0, rk = 0;
+    float st = 0;
+    uint8_t sk = 0;
     bool unresolved = false;  // cluster links whose nodes overlap: must be split if they carry light
+    // A chain link (see chain_etendue): both ends are arcs of one convex
+    // loop; coef is the exact F_rs (crossed strings), the sender's value its
+    // mean radiosity and the receiver gets it evenly (a scalar, no table);
+    // vis_err bounds coef's rounding.
+    bool uniform = false;
     bool clear = false;       // element links whose shaft held no blocker: nor do their children's
     // Visibility not asked yet (coef unoccluded): a cluster link's
     // transmittance, an element link's occluded F. The refinement asks only
@@ -184,13 +194,47 @@ struct Link {
     float s_back = 0, r_back = 0;
     Vec2 u() const { return {ux, uy}; }
     BinWeight sbin() const { return {sk, st}; }
-    BinWeight rbin() const { return {rk, rt}; }
+    BinWeight rbin() const { return opposite(sbin()); }  // arrival: the exitance bin half a table on
 };
 static_assert(sizeof(Link) == 64);
 
 // Link vectors grow with resize(n) only where every new link is then
 // written (sort_links): their pages are first touched by that write.
 using LinkVector = std::vector<Link, UninitializedAllocator<Link>>;
+
+// A convex loop's cycle (engine/connectivity.h's SceneLoop), and an arc of
+// it: its ends, oriented with the room on the left (chain links).
+struct ConvexLoop {
+    std::vector<Vec2> polygon;  // SceneLoop::polygon
+    int orientation = 0;
+};
+struct ChainEnds {
+    Vec2 a, b;
+    int32_t loop = -1;
+};
+
+// Chain links: the etendue L_r F_rs between two arcs of one convex loop,
+// each given by its ends oriented with the room on the left (r: a0 -> a1,
+// s: b0 -> b1). Inside a convex room every point of one arc sees every
+// point of the other, and every line between them crosses both chords, so
+// Hottel's crossed strings on the chords are exact (DESIGN.md §1; the
+// chords are lit-left segments, each on the other's lit side):
+//   L_r F_rs = (|a0 b0| + |a1 b1| - |a0 b1| - |a1 b0|) / 2,
+// evaluated by engine/formfactor.h's stable form (a few ulps of the
+// chords' lengths; `rounding` gets 16 of them). An arc with itself (r = s,
+// length L): L F_rr = L - |a0 a1| (what leaves the arc and does not cross
+// its chord); L is a sum over its walls, counted at 64 ulps.
+// (tests/engine/formfactor_test.cpp checks both against the sum of every
+// pair of walls' form factors.)
+double chain_etendue(Vec2 a0, Vec2 a1, Vec2 b0, Vec2 b1, double& rounding) {
+    rounding = 16 * std::numeric_limits<double>::epsilon() * (norm(a1 - a0) + norm(b1 - b0));
+    return exchange_crossed_strings(Segment{a0, a1}, Segment{b0, b1});
+}
+double chain_self_etendue(Vec2 a0, Vec2 a1, double length, double& rounding) {
+    const double chord = norm(a1 - a0);
+    rounding = 64 * std::numeric_limits<double>::epsilon() * (length + chord);
+    return std::max(0.0, length - chord);
+}
 
 Link link_between(int r, int s) {
     Link l;
@@ -295,6 +339,8 @@ private:
     void refuse_closed_white() const;
     void convex_object_skips(const Connectivity& conn);
     void build_tree();
+    void mark_chains();
+    bool chain_ends(const Node& n, ChainEnds& out) const;
     void endpoints(int node, std::vector<int>& out) const;
     void children_links(const Link& l, bool split_r, LinkVector& out) const;
     void self_links(int node, LinkVector& out) const;
@@ -356,6 +402,15 @@ private:
     // does not count as blockers (itself, or its highest ancestor made of
     // the same convex closed loop: see convex_object_skips).
     std::vector<int32_t> m_tau_skip;
+    // Chain links (mark_chains, chain_etendue): the convex loops, and per
+    // segment its loop and place in the loop's cycle (-1: none); per
+    // cluster table the ends of its chain, oriented with the room on the
+    // left (loop -1: not a chain).
+    std::vector<ConvexLoop> m_convex_loops;
+    std::vector<int32_t> m_seg_loop, m_seg_pos;
+    std::vector<ChainEnds> m_chain_ends;
+    bool m_chains = false;       // some cluster is a chain and nothing can block: chain links are made
+    std::vector<double> m_Bmax;  // refine: per node, the highest leaf value below (chain links' error)
     std::vector<int> m_patch_root;  // per patch: its element tree's root node
 
     std::vector<Node> m_nodes;
@@ -466,6 +521,17 @@ void HierarchicalSolver::convex_object_skips(const Connectivity& conn) {
         }
         if (!convex) continue;
         for (int sgm : loop.segments) seg_loop[static_cast<size_t>(sgm)] = static_cast<int>(L);
+        // For chain links: the loop's cycle (mark_chains).
+        const int32_t id = static_cast<int32_t>(m_convex_loops.size());
+        m_convex_loops.push_back({loop.polygon, loop.orientation});
+        if (m_seg_loop.empty()) {
+            m_seg_loop.assign(m_scene.segments.size(), -1);
+            m_seg_pos.assign(m_scene.segments.size(), -1);
+        }
+        for (size_t k = 0; k < n; ++k) {
+            m_seg_loop[static_cast<size_t>(loop.segments[k])] = id;
+            m_seg_pos[static_cast<size_t>(loop.segments[k])] = static_cast<int32_t>(k);
+        }
     }
     // Per node: the one convex loop all its segments are on, or -1.
     std::vector<int> node_loop(hn.size(), -1);
@@ -619,6 +685,96 @@ void HierarchicalSolver::build_tree() {
             }
         }
     }
+    mark_chains();
+}
+
+// Chains: which nodes are arcs of one convex loop, lit on the room's side
+// (see Node::chain). Children first: an element is a chain when its wall is
+// on a convex loop and it is lit on the room's side (oriented with the
+// room on its left, it starts where its wall does in that direction); a
+// cluster when every child is a chain of the same loop and their walls
+// make one run of consecutive places in the loop's cycle (cyclic intervals
+// that touch end to start, with at most one gap round the cycle).
+// Only where nothing can block: a chain link carries its exact etendue
+// unoccluded.
+void HierarchicalSolver::mark_chains() {
+    m_chain_ends.assign(static_cast<size_t>(m_tables_count), ChainEnds{});
+    m_chains = false;
+    if (!m_opt.chain_links || !m_unblockable || m_convex_loops.empty()) return;
+    const size_t N = m_nodes.size();
+    // Per node: its walls' run in the cycle, [start, start + count) modulo
+    // the cycle's length.
+    std::vector<int32_t> start(N, -1), count(N, 0), loop(N, -1);
+    struct Run {
+        int32_t start, count;
+    };
+    std::vector<Run> runs;
+    for (size_t k = N; k-- > 0;) {
+        Node& n = m_nodes[k];
+        if (n.kind == Kind::Element) {
+            const int32_t L = m_seg_loop[static_cast<size_t>(n.segment)];
+            if (L < 0) continue;
+            const ConvexLoop& cl = m_convex_loops[static_cast<size_t>(L)];
+            const size_t m = cl.polygon.size(), p = static_cast<size_t>(m_seg_pos[static_cast<size_t>(n.segment)]);
+            if (!(n.seg.a == (cl.orientation > 0 ? cl.polygon[p] : cl.polygon[(p + 1) % m]))) continue;  // lit outside
+            n.chain = true;
+            start[k] = static_cast<int32_t>(p);
+            count[k] = 1;
+            loop[k] = L;
+            continue;
+        }
+        if (!n.cluster() || n.nchild <= 0) continue;
+        const int32_t L = loop[static_cast<size_t>(n.child)];
+        runs.clear();
+        double length = 0;
+        int64_t total = 0;
+        bool chain = L >= 0;
+        for (int c = n.child; c < n.child + n.nchild && chain; ++c) {
+            const Node& child = m_nodes[static_cast<size_t>(c)];
+            chain = child.chain && loop[static_cast<size_t>(c)] == L;
+            runs.push_back({start[static_cast<size_t>(c)], count[static_cast<size_t>(c)]});
+            total += count[static_cast<size_t>(c)];
+            length += child.length;
+        }
+        if (!chain) continue;
+        const int64_t m = static_cast<int64_t>(m_convex_loops[static_cast<size_t>(L)].polygon.size());
+        if (total > m) continue;
+        std::sort(runs.begin(), runs.end(), [](const Run& x, const Run& y) { return x.start < y.start; });
+        int gaps = 0;
+        int32_t first = runs[0].start;
+        for (size_t i = 0; i < runs.size(); ++i) {
+            const Run& next = runs[(i + 1) % runs.size()];
+            if ((runs[i].start + runs[i].count) % m != next.start) {
+                ++gaps;
+                first = next.start;
+            }
+        }
+        if (gaps > 1 || (gaps == 0 && total != m)) continue;
+        n.chain = true;
+        n.length = length;
+        start[k] = first;
+        count[k] = static_cast<int32_t>(total);
+        loop[k] = L;
+        if (n.table >= 0) {
+            const ConvexLoop& cl = m_convex_loops[static_cast<size_t>(L)];
+            const Vec2 from = cl.polygon[static_cast<size_t>(first)], to = cl.polygon[static_cast<size_t>((first + total) % m)];
+            m_chain_ends[static_cast<size_t>(n.table)] = cl.orientation > 0 ? ChainEnds{from, to, L} : ChainEnds{to, from, L};
+            m_chains = true;
+        }
+    }
+}
+
+// The ends of n's chain, oriented with the room on the left; false when n
+// is not a chain (or a cluster without a table: no link ends there).
+bool HierarchicalSolver::chain_ends(const Node& n, ChainEnds& out) const {
+    if (!n.chain) return false;
+    if (n.cluster()) {
+        if (n.table < 0) return false;
+        out = m_chain_ends[static_cast<size_t>(n.table)];
+        return out.loop >= 0;
+    }
+    out = {n.seg.a, n.seg.b, m_seg_loop[static_cast<size_t>(n.segment)]};
+    return true;
 }
 
 // The nodes a link to `node` really goes to: a hierarchy leaf stands for
@@ -680,7 +836,20 @@ void HierarchicalSolver::children_links(const Link& l, bool split_r, LinkVector&
 bool HierarchicalSolver::make_link(int r, int s, Link& l, VisibilityStats& st) const {
     const Node& nr = m_nodes[static_cast<size_t>(r)];
     const Node& ns = m_nodes[static_cast<size_t>(s)];
-    if (r == s) return true;  // a cluster's self link: always split, carries nothing itself
+    if (r == s) {
+        // A cluster's self link: split, carrying nothing itself, unless the
+        // cluster is a chain (an arc sees itself): a chain link, split only
+        // when its error asks (refine).
+        ChainEnds a;
+        if (m_chains && nr.cluster() && chain_ends(nr, a)) {
+            double rounding = 0;
+            const double et = chain_self_etendue(a.a, a.b, nr.length, rounding);
+            l.uniform = true;
+            l.coef = et / nr.length;
+            l.vis_err = static_cast<float>(rounding / nr.length);
+        }
+        return true;
+    }
     if ((ns.send_rooms & nr.recv_rooms) == 0) {  // a closed loop between them (solver/rooms.h)
         ++st.culled;
         return false;
@@ -731,16 +900,27 @@ bool HierarchicalSolver::make_link(int r, int s, Link& l, VisibilityStats& st) c
         return false;
     }
     if (!(dist > reach) || straddles(nr, ns) || straddles(ns, nr)) {
+        // Two arcs of one convex loop (neighbours along a curved wall,
+        // where the point approximation never holds): a chain link, its
+        // etendue exact, the sender's mean spread evenly on the receiver.
+        ChainEnds a, b;
+        if (m_chains && chain_ends(nr, a) && chain_ends(ns, b) && a.loop == b.loop) {
+            double rounding = 0;
+            const double et = chain_etendue(a.a, a.b, b.a, b.b, rounding);
+            l.uniform = true;
+            l.coef = et / nr.length;
+            l.vis_err = static_cast<float>(rounding / nr.length);
+            ++st.unoccluded;
+            return true;
+        }
         l.unresolved = true;
         l.coef = 0;
         return true;
     }
     const Vec2 u = d / dist;  // from s to r
-    const BinWeight sbin = bin_of(u), rbin = opposite(sbin);
+    const BinWeight sbin = bin_of(u);
     l.sk = static_cast<uint8_t>(sbin.k);
     l.st = static_cast<float>(sbin.t);
-    l.rk = static_cast<uint8_t>(rbin.k);
-    l.rt = static_cast<float>(rbin.t);
     l.ux = static_cast<float>(u.x);
     l.uy = static_cast<float>(u.y);
     // A cluster none of whose senders faces any point of r from where it
@@ -989,6 +1169,13 @@ void HierarchicalSolver::pull_tables(const double* leaf_value, std::vector<doubl
                 Bn[k] = 0.5 * (Bn[a] + Bn[a + 1]);  // halves of equal length
             }
         }
+        if (n.chain && n.kind == Kind::Cluster && m_chains) {
+            // A chain's mean (chain links send it): its length is its elements'.
+            double power = 0;
+            for (int c = n.child; c < n.child + n.nchild; ++c)
+                power += m_op[static_cast<size_t>(c)].length * Bn[static_cast<size_t>(c)];
+            Bn[k] = power / n.length;
+        }
         if (n.kind != Kind::Cluster || n.up_table < 0 || !in_part(part, static_cast<int>(k), n.parent)) continue;
         if (n.table >= 0) {
             I.sum_child(n.up_table, n.table);
@@ -1015,6 +1202,13 @@ LinkError HierarchicalSolver::link_error(const Link& l, const std::vector<double
     constexpr double inf = std::numeric_limits<double>::infinity();
     const double size_r = r.cluster() ? 2 * r.radius : r.length;
     const double size_s = s.cluster() ? 2 * s.radius : s.length;
+    if (l.uniform) {
+        // A chain link carries the sender's mean at the exact etendue: the
+        // power it moves is right for an even sender, and at most all of it
+        // (the etendue times the sender's highest value, rounding included)
+        // lands in the wrong place on the receiver or is missed.
+        return {(l.coef + l.vis_err) * r.length * m_Bmax[static_cast<size_t>(l.s)], size_r >= size_s};
+    }
     if (l.r == l.s) return {inf, true};
     if (!r.cluster() && !s.cluster()) {
         const double power = Bn[static_cast<size_t>(l.s)] * r.length;
@@ -1204,6 +1398,15 @@ bool HierarchicalSolver::refine(const std::vector<double>& leaf_bmax) {
     TableArray& I = m_I;
     I.reset_full(m_tables_count);  // new links may read any table's samples (pull_tables zeroes them)
     pull_tables(leaf_bmax.data(), Bn, I);
+    if (m_chains) {
+        // The highest leaf value below each node (chain links' error).
+        m_Bmax.assign(m_nodes.size(), 0.0);
+        for (size_t k = m_nodes.size(); k-- > 0;) {
+            const OpNode& n = m_op[k];
+            if (n.kind == Kind::Element && n.child < 0) m_Bmax[k] = Bn[k];
+            if (n.parent >= 0) m_Bmax[static_cast<size_t>(n.parent)] = std::max(m_Bmax[static_cast<size_t>(n.parent)], m_Bmax[k]);
+        }
+    }
     // eps_abs = eps * W / N (see the header).
     CompensatedSum W;
     long patches = 0;
@@ -1263,7 +1466,7 @@ bool HierarchicalSolver::refine(const std::vector<double>& leaf_bmax) {
                 Link& l = m_links[tail + static_cast<size_t>(k)];
                 const Node& r = m_nodes[static_cast<size_t>(l.r)];
                 const Node& s = m_nodes[static_cast<size_t>(l.s)];
-                if (l.r == l.s) {
+                if (l.r == l.s && !l.uniform) {
                     decision[static_cast<size_t>(k)] = 3;
                     continue;
                 }
@@ -1305,7 +1508,7 @@ bool HierarchicalSolver::refine(const std::vector<double>& leaf_bmax) {
                 if (e.err > eps_abs) above = true;
                 if (e.err <= split_at) continue;
                 const bool split_r = can_r && (!can_s || e.split_r);
-                decision[static_cast<size_t>(k)] = split_r ? 1 : 2;
+                decision[static_cast<size_t>(k)] = l.r == l.s ? 3 : split_r ? 1 : 2;  // (a chain's self link)
             }
 #pragma omp critical
             {
@@ -1318,8 +1521,10 @@ bool HierarchicalSolver::refine(const std::vector<double>& leaf_bmax) {
         // The first wave holds every link: if none exceeds eps_abs, the
         // round splits nothing (links that nothing passes are still dropped).
         if (first_wave && !exceeded)
-            for (char& d : decision)
-                if (d == 1 || d == 2) d = 0;
+            for (size_t k = 0; k < decision.size(); ++k) {
+                char& d = decision[k];
+                if (d == 1 || d == 2 || (d == 3 && m_links[tail + k].uniform)) d = 0;
+            }
         // 2. Split (serially: creates nodes), collecting the children links,
         // and keep the tail's survivors in place.
         LinkVector& fresh = m_fresh;
@@ -1344,6 +1549,8 @@ bool HierarchicalSolver::refine(const std::vector<double>& leaf_bmax) {
             if (m_nodes[static_cast<size_t>(node)].kind == Kind::Element) {
                 split_element(node);
                 while (Bn.size() < m_nodes.size()) Bn.push_back(Bn[static_cast<size_t>(node)]);  // halves start at the mean
+                if (m_chains)
+                    while (m_Bmax.size() < m_nodes.size()) m_Bmax.push_back(m_Bmax[static_cast<size_t>(node)]);
             }
             children_links(l, split_r, fresh);
         }
@@ -1381,6 +1588,7 @@ void HierarchicalSolver::collect_leaves() {
         o.leaf_cluster = n.leaf_cluster;
         o.normal = n.normal;
         o.length = n.length;
+        o.chain = n.chain;
         const Node* p = n.parent >= 0 ? &m_nodes[static_cast<size_t>(n.parent)] : nullptr;
         o.side = !n.cluster() && p && p->cluster();
         o.up_table = -1;
@@ -1486,6 +1694,7 @@ void HierarchicalSolver::sample_slots() {
     const size_t T = static_cast<size_t>(m_tables_count);
     std::vector<char> need_I(T, 0), need_J(T, 0);
     for (const Link& l : m_links) {
+        if (l.uniform) continue;  // chain links read means and spread evenly: no table
         const int32_t rt = m_op[static_cast<size_t>(l.r)].table, st = m_op[static_cast<size_t>(l.s)].table;
         if (st >= 0 && !l.s_linear) need_I[static_cast<size_t>(st)] = 1;
         if (rt >= 0 && !l.r_linear) need_J[static_cast<size_t>(rt)] = 1;
@@ -1580,14 +1789,14 @@ void HierarchicalSolver::push_down(TableArray& tables, const std::vector<double>
         const OpNode& n = m_op[k];
         above[k] = 0;
         if (n.parent < 0 || !in_part(part, static_cast<int>(k), n.parent)) continue;
+        // What reached the parent evenly (an element's own links, chain
+        // links to clusters above) reaches every node below.
+        above[k] = own[static_cast<size_t>(n.parent)] + above[static_cast<size_t>(n.parent)];
         if (n.kind == Kind::Cluster) {
             if (n.table >= 0 && n.up_table >= 0) tables.add_parent(n.table, n.up_table);
-        } else if (n.side) {
+        } else if (n.side && n.up_table >= 0) {
             // Its leaf cluster: no link ends there, its table is its parent's.
-            if (n.up_table >= 0)
-                above[k] = lobe_scale * read_cosine_lobe(tables.samples(n.up_table), tables.linear(n.up_table), n.normal);
-        } else {
-            above[k] = own[static_cast<size_t>(n.parent)] + above[static_cast<size_t>(n.parent)];
+            above[k] += lobe_scale * read_cosine_lobe(tables.samples(n.up_table), tables.linear(n.up_table), n.normal);
         }
     }
 }
@@ -1614,21 +1823,21 @@ void HierarchicalSolver::apply_G(const Eigen::VectorXd& x, Eigen::VectorXd& out,
         for (int32_t k = m_link_start[static_cast<size_t>(q)]; k < m_link_start[static_cast<size_t>(q) + 1]; ++k) {
             const Link& l = m_links[static_cast<size_t>(k)];
             const int32_t t = m_op[static_cast<size_t>(l.s)].table;  // -1: an element sends its mean
-            const double v = t < 0        ? m_Bn[static_cast<size_t>(l.s)]
-                             : l.s_linear ? read_linear_part(m_I.linear(t), l.u())
-                                          : interpolate(m_I.samples(t), l.sbin());
+            const double v = t < 0 || l.uniform ? m_Bn[static_cast<size_t>(l.s)]
+                             : l.s_linear       ? read_linear_part(m_I.linear(t), l.u())
+                                                : interpolate(m_I.samples(t), l.sbin());
             const double c = l.coef * v;
-            if (to_table && l.r_linear) {
+            if (!to_table || l.uniform) {
+                h += c;  // an element's irradiance, or what a chain spreads evenly below
+            } else if (l.r_linear) {
                 add_linear_part(J_linear, -l.u(), c);  // arrives from the sender's direction
-            } else if (to_table) {
+            } else {
                 const BinWeight b = l.rbin();
                 J[b.k] += (1 - b.t) * c;
                 J[b.next()] += b.t * c;
-            } else {
-                h += c;
             }
         }
-        if (!to_table) m_Hn[static_cast<size_t>(r)] = h;
+        m_Hn[static_cast<size_t>(r)] = h;
     }
     // Push: tables down the clusters, then onto sides, then down elements.
     push_down(m_J, m_Hn, 1.0, m_Ha, part);  // m_Ha: what arrived at ancestors (row-sum correction)
@@ -1899,8 +2108,9 @@ std::vector<double> HierarchicalSolver::landed_fraction() const {
         const Node& r = m_nodes[static_cast<size_t>(l.r)];
         const Node& s = m_nodes[static_cast<size_t>(l.s)];
         const double* S = r.cluster() ? &m_sensitivity[static_cast<size_t>(r.table) * TW] : nullptr;
-        const double d = l.coef * (!S ? r.length : l.r_linear ? read_linear(S, -l.u()) : interpolate(S, l.rbin()));
-        if (s.cluster()) {
+        const double d =
+            l.coef * (!S || l.uniform ? r.length : l.r_linear ? read_linear(S, -l.u()) : interpolate(S, l.rbin()));
+        if (s.cluster() && !l.uniform) {
             if (l.s_linear) {
                 add_linear_part(lam.linear(s.table), l.u(), d);
             } else {
@@ -2011,6 +2221,7 @@ Solution HierarchicalSolver::run() {
     sol.stats.links = static_cast<long>(m_links.size());
     sol.stats.patches_left_out = m_left_out;
     sol.stats.cluster_links = m_cluster_links;
+    sol.stats.chain_links = std::count_if(m_links.begin(), m_links.end(), [](const Link& l) { return l.uniform; });
     sol.stats.cluster_tables = m_tables_count;
     sol.stats.sampled_tables = std::max(m_I_slotted, m_J_slotted);
     sol.stats.independent_parts = m_part_count;

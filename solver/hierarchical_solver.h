@@ -57,7 +57,18 @@
 ///    forest: 59 s -> 20 s for cluster links, 18.6 -> 14.9 s more for
 ///    element links).
 ///    Overlapping nodes (d <= rho_r + rho_s, or an element whose line cuts
-///    the cluster's box) are always split when they carry light. The first
+///    the cluster's box) are always split when they carry light, except
+///    chain links: where nothing can block, two arcs of one convex loop lit
+///    on the room's side (neighbours along a curved wall) exchange their
+///    exact etendue (crossed strings on their chords; an arc with itself:
+///    its length minus its chord), the sender's mean spread evenly on the
+///    receiver, with the power they carry at the sender's highest value as
+///    their error (stats.chain_links). Along a wall of N segments turning
+///    by 2 pi / N each, arcs of n walls exchange ~n^3 (2 pi / N)^2 / 8 of a
+///    wall's power, so at 10^6 walls and eps 3e-3 arcs of ~800 walls need
+///    no finer links: a round room of 10^6 walls kept 8.8 M links without
+///    them, 2.6 M with (the same error against exact on 1000 and 4000
+///    walls, to 3 digits). The first
 ///    round refines against a guess (every patch at E + rho B_bar, B_bar
 ///    the radiosity of a closed room with the scene's emission and
 ///    absorption), then refine, solve, refine until no link splits.
@@ -113,6 +124,11 @@ struct HierarchicalOptions {
     /// with every patch reached, without the light-flow check (proof in
     /// solve()); off: checked like any scene (the same solution, for tests).
     bool convex_room_shortcut = true;
+    /// Chain links: two arcs of one convex loop too close for the point
+    /// approximation exchange their exact etendue, spread evenly, while that
+    /// is within eps (see above); off: refined like any other pair (the same
+    /// accuracy with more links, for tests).
+    bool chain_links = true;
     /// Called now and then from the solving thread with what is being done
     /// ("refine pass 2", "solve", ...) and a fraction in [0, 1] of the whole
     /// run when one is known (< 0 otherwise). Empty: no reports. The CLI

@@ -45,6 +45,7 @@ struct SolveStats {
     long iterations = 0;     ///< 0 for a direct solve
     long patches_left_out = 0;  ///< hierarchical: patches no emitter can reach (not solved; B = E = 0)
     long cluster_links = 0;     ///< hierarchical: links with a cluster at either end (part of `links`)
+    long chain_links = 0;       ///< hierarchical: links between arcs of one convex loop, exact etendue, spread evenly (part of `links`)
     long independent_parts = 0; ///< hierarchical: sub-scenes no light passes between, solved apart
     long cluster_tables = 0;    ///< hierarchical: clusters with a directional model (solver/directional.h)
     long sampled_tables = 0;    ///< hierarchical: of those, the ones whose samples the final solve kept (the rest: linear part only)

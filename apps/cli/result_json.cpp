@@ -1,6 +1,11 @@
 #include "cli/result_json.h"
 
+#include <charconv>
+#include <cmath>
 #include <cstddef>
+#include <cstdlib>
+#include <string_view>
+#include <vector>
 
 namespace flatrad {
 
@@ -15,6 +20,112 @@ std::string compact(const ordered_json& j) {
 }
 
 ordered_json point_json(Vec2 p) { return ordered_json::array({p.x, p.y}); }
+
+// The keys before "patches" and after it.
+ordered_json result_head(const Scene& scene, const Solution& solution) {
+    ordered_json j;
+    j["flatrad"] = 1;
+    j["scene"] = scene.name;
+    j["method"] = solution.method;
+
+    ordered_json settings;
+    settings["subdivide"] = solution.subdivide;
+    if (solution.method == "hierarchical") {
+        settings["eps"] = solution.eps;
+        settings["vis_eps"] = solution.vis_eps;
+    }
+    j["settings"] = settings;
+    return j;
+}
+
+void result_tail(ordered_json& j, const Solution& solution) {
+    const Totals& t = solution.totals;
+    j["totals"] = ordered_json{{"emitted", t.emitted},
+                               {"absorbed", t.absorbed},
+                               {"escaped", t.escaped},
+                               {"balance", t.balance}};
+
+    const SolveStats& s = solution.stats;
+    ordered_json stats;
+    stats["time_s"] = s.time_s;
+    stats["elements"] = s.elements;
+    stats["links"] = s.links;
+    stats["iterations"] = s.iterations;
+    stats["patches_left_out"] = s.patches_left_out;
+    stats["cluster_links"] = s.cluster_links;
+    stats["chain_links"] = s.chain_links;
+    stats["independent_parts"] = s.independent_parts;
+    stats["cluster_tables"] = s.cluster_tables;
+    stats["sampled_tables"] = s.sampled_tables;
+    stats["residual"] = s.residual;
+    stats["threads"] = s.threads;
+    stats["form_factor_time_s"] = s.form_factor_time_s;
+    stats["linear_solve_time_s"] = s.linear_solve_time_s;
+    stats["visibility"] = visibility_stats_json(s.visibility);
+    j["stats"] = std::move(stats);
+}
+
+// A double as nlohmann's dump writes it (SPEC.md's numbers): shortest
+// round-trip digits (std::to_chars), plain notation for decimal exponents
+// -4 .. 15 with ".0" on integral values, else d.ddde+XX; null when not
+// finite.
+void append_number(std::string& out, double v) {
+    if (!std::isfinite(v)) {
+        out += "null";
+        return;
+    }
+    char buf[64];
+    const auto res = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::scientific);
+    std::string_view sci(buf, static_cast<size_t>(res.ptr - buf));
+    if (sci.front() == '-') {
+        out += '-';
+        sci.remove_prefix(1);
+    }
+    const size_t e = sci.find('e');
+    int exp10 = 0;
+    std::from_chars(sci.data() + e + (sci[e + 1] == '+' ? 2 : 1), sci.data() + sci.size(), exp10);
+    char digits[32];
+    int k = 0;
+    for (size_t i = 0; i < e; ++i)
+        if (sci[i] != '.') digits[k++] = sci[i];
+    const int n = exp10 + 1;  // the value is 0.digits x 10^n
+    if (v == 0) {
+        out += "0.0";
+    } else if (k <= n && n <= 15) {
+        out.append(digits, static_cast<size_t>(k));
+        out.append(static_cast<size_t>(n - k), '0');
+        out += ".0";
+    } else if (0 < n && n <= 15) {
+        out.append(digits, static_cast<size_t>(n));
+        out += '.';
+        out.append(digits + n, static_cast<size_t>(k - n));
+    } else if (-4 < n && n <= 0) {
+        out += "0.";
+        out.append(static_cast<size_t>(-n), '0');
+        out.append(digits, static_cast<size_t>(k));
+    } else {
+        out += digits[0];
+        if (k > 1) {
+            out += '.';
+            out.append(digits + 1, static_cast<size_t>(k - 1));
+        }
+        out += 'e';
+        const int x = n - 1;
+        out += x < 0 ? '-' : '+';
+        const int ax = std::abs(x);
+        if (ax < 10) out += '0';
+        out += std::to_string(ax);
+    }
+}
+
+void append_array(std::string& out, const std::vector<double>& values) {
+    out += '[';
+    for (size_t i = 0; i < values.size(); ++i) {
+        if (i > 0) out += ',';
+        append_number(out, values[i]);
+    }
+    out += ']';
+}
 
 }  // namespace
 
@@ -33,21 +144,9 @@ ordered_json visibility_stats_json(const VisibilityStats& s) {
 }
 
 ordered_json result_json(const Scene& scene, const Solution& solution) {
-    ordered_json j;
-    j["flatrad"] = 1;
-    j["scene"] = scene.name;
-    j["method"] = solution.method;
-
-    ordered_json settings;
-    settings["subdivide"] = solution.subdivide;
-    if (solution.method == "hierarchical") {
-        settings["eps"] = solution.eps;
-        settings["vis_eps"] = solution.vis_eps;
-    }
-    j["settings"] = settings;
-
+    ordered_json j = result_head(scene, solution);
     ordered_json patches = ordered_json::array();
-    for (std::size_t p = 0; p < scene.patches.size(); ++p) {
+    for (size_t p = 0; p < scene.patches.size(); ++p) {
         const Patch& patch = scene.patches[p];
         const SceneSegment& seg = scene.segments[static_cast<std::size_t>(patch.segment)];
         const PatchResult& r = solution.patches.at(p);
@@ -69,30 +168,7 @@ ordered_json result_json(const Scene& scene, const Solution& solution) {
         patches.push_back(std::move(pj));
     }
     j["patches"] = std::move(patches);
-
-    const Totals& t = solution.totals;
-    j["totals"] = ordered_json{{"emitted", t.emitted},
-                               {"absorbed", t.absorbed},
-                               {"escaped", t.escaped},
-                               {"balance", t.balance}};
-
-    const SolveStats& s = solution.stats;
-    ordered_json stats;
-    stats["time_s"] = s.time_s;
-    stats["elements"] = s.elements;
-    stats["links"] = s.links;
-    stats["iterations"] = s.iterations;
-    stats["patches_left_out"] = s.patches_left_out;
-    stats["cluster_links"] = s.cluster_links;
-    stats["independent_parts"] = s.independent_parts;
-    stats["cluster_tables"] = s.cluster_tables;
-    stats["sampled_tables"] = s.sampled_tables;
-    stats["residual"] = s.residual;
-    stats["threads"] = s.threads;
-    stats["form_factor_time_s"] = s.form_factor_time_s;
-    stats["linear_solve_time_s"] = s.linear_solve_time_s;
-    stats["visibility"] = visibility_stats_json(s.visibility);
-    j["stats"] = std::move(stats);
+    result_tail(j, solution);
     return j;
 }
 
@@ -116,6 +192,60 @@ std::string format_result(const ordered_json& result) {
             text += compact(value);
         }
     }
+    text += "\n}\n";
+    return text;
+}
+
+std::string result_text(const Scene& scene, const Solution& solution) {
+    const ordered_json head = result_head(scene, solution);
+    ordered_json tail;
+    result_tail(tail, solution);
+    std::string text = "{\n";
+    for (auto it = head.begin(); it != head.end(); ++it)
+        text += "  " + compact(ordered_json(it.key())) + ": " + compact(it.value()) + ",\n";
+    text += "  \"patches\": [";
+    // The names once each, escaped as the DOM would.
+    std::vector<std::string> names(scene.surfaces.size());
+    for (size_t k = 0; k < names.size(); ++k) names[k] = compact(ordered_json(scene.surfaces[k].name));
+    size_t elements = 0;
+    for (const PatchResult& r : solution.patches) elements += r.elements.size();
+    text.reserve(text.size() + 200 * scene.patches.size() + 80 * elements);
+    for (size_t p = 0; p < scene.patches.size(); ++p) {
+        const Patch& patch = scene.patches[p];
+        const SceneSegment& seg = scene.segments[static_cast<std::size_t>(patch.segment)];
+        const PatchResult& r = solution.patches.at(p);
+        text += p == 0 ? "\n    {\"surface\":" : ",\n    {\"surface\":";
+        text += names[static_cast<size_t>(patch.surface)];
+        text += ",\"segment\":";
+        text += std::to_string(seg.index);
+        text += ",\"side\":\"";
+        text += side_name(patch.side);
+        text += "\",\"a\":";
+        append_array(text, {seg.seg.a.x, seg.seg.a.y});
+        text += ",\"b\":";
+        append_array(text, {seg.seg.b.x, seg.seg.b.y});
+        text += ",\"length\":";
+        append_number(text, patch.length);
+        text += ",\"radiosity\":";
+        append_array(text, r.radiosity);
+        text += ",\"elements\":[";
+        for (size_t i = 0; i < r.elements.size(); ++i) {
+            const ElementValue& e = r.elements[i];
+            text += i == 0 ? "[" : ",[";
+            append_number(text, e.t0);
+            text += ',';
+            append_number(text, e.t1);
+            for (double b : e.B) {
+                text += ',';
+                append_number(text, b);
+            }
+            text += ']';
+        }
+        text += "]}";
+    }
+    text += scene.patches.empty() ? "]" : "\n  ]";
+    for (auto it = tail.begin(); it != tail.end(); ++it)
+        text += ",\n  " + compact(ordered_json(it.key())) + ": " + compact(it.value());
     text += "\n}\n";
     return text;
 }

@@ -68,7 +68,7 @@ int run_solve(const SolveArgs& args, std::ostream& out, std::ostream& err) {
         solution = solve_exact(scene, options);
     }
 
-    const std::string text = format_result(result_json(scene, solution));
+    const std::string text = result_text(scene, solution);
     // Drawn before anything is written, so that a failure writes nothing.
     const std::string picture = args.svg.empty() ? std::string() : render_scene_svg(scene, solution);
     if (args.output.empty()) {
