@@ -47,6 +47,9 @@ constexpr int TW = directional_table_width;  // samples, then the linear part
 // refinement's decisions) a batch runs on one thread; geometry and gathers
 // (~1 us each) need 16x more.
 constexpr long parallel_min_work = 64;
+// Chain links are made in rooms holding at most this many segments that
+// may block, each checked against each chain link (chain_clear).
+constexpr long max_chain_blockers = 64;
 
 // Multi-scale visibility approximates clusters only in shafts holding at
 // least this many blocker pieces: below it, the criterion's set-up and the
@@ -300,6 +303,13 @@ public:
         const std::vector<char> blockers = possible_blockers(scene);
         m_hierarchy.set_blockers(blockers);
         m_unblockable = std::find(blockers.begin(), blockers.end(), 1) == blockers.end();
+        // A few things inside a room (a lamp, a pillar): chain links check
+        // them one by one (chain_clear); with more, none is made.
+        if (std::count(blockers.begin(), blockers.end(), 1) <= max_chain_blockers) {
+            m_few_blockers = true;
+            for (size_t k = 0; k < blockers.size(); ++k)
+                if (blockers[k]) m_chain_blockers.push_back(scene.segments[k].seg);
+        }
         SceneFacts facts = m_facts.get();
         m_escape_free = std::move(facts.escape_free);
         m_visible_sink = std::move(facts.visible_sink);
@@ -341,6 +351,7 @@ private:
     void build_tree();
     void mark_chains();
     bool chain_ends(const Node& n, ChainEnds& out) const;
+    bool chain_clear(const ChainEnds& a, const ChainEnds& b) const;
     void endpoints(int node, std::vector<int>& out) const;
     void children_links(const Link& l, bool split_r, LinkVector& out) const;
     void self_links(int node, LinkVector& out) const;
@@ -409,7 +420,9 @@ private:
     std::vector<ConvexLoop> m_convex_loops;
     std::vector<int32_t> m_seg_loop, m_seg_pos;
     std::vector<ChainEnds> m_chain_ends;
-    bool m_chains = false;       // some cluster is a chain and nothing can block: chain links are made
+    bool m_chains = false;       // some cluster is a chain and few things can block: chain links are made
+    bool m_few_blockers = false;  // at most max_chain_blockers segments may block
+    std::vector<Segment> m_chain_blockers;  // those segments (chain_clear)
     std::vector<double> m_Bmax;  // refine: per node, the highest leaf value below (chain links' error)
     std::vector<int> m_patch_root;  // per patch: its element tree's root node
 
@@ -695,12 +708,12 @@ void HierarchicalSolver::build_tree() {
 // cluster when every child is a chain of the same loop and their walls
 // make one run of consecutive places in the loop's cycle (cyclic intervals
 // that touch end to start, with at most one gap round the cycle).
-// Only where nothing can block: a chain link carries its exact etendue
-// unoccluded.
+// Only where few segments can block (a chain link carries its exact
+// etendue unoccluded: chain_clear checks each of them).
 void HierarchicalSolver::mark_chains() {
     m_chain_ends.assign(static_cast<size_t>(m_tables_count), ChainEnds{});
     m_chains = false;
-    if (!m_opt.chain_links || !m_unblockable || m_convex_loops.empty()) return;
+    if (!m_opt.chain_links || !m_few_blockers || m_convex_loops.empty()) return;
     const size_t N = m_nodes.size();
     // Per node: its walls' run in the cycle, [start, start + count) modulo
     // the cycle's length.
@@ -762,6 +775,26 @@ void HierarchicalSolver::mark_chains() {
             m_chains = true;
         }
     }
+}
+
+// Whether no segment that may block meets a line between arcs a and b of
+// one convex loop (a == b: an arc and itself). Such lines lie in the
+// convex hull of the two arcs, which lies on the arc's side (the right) of
+// the chord from a's start to b's end, and of the chord from b's start to
+// a's end (each closes one of the two runs of the loop that hold both
+// arcs): a segment strictly on the room's side of either chord (beyond
+// orient's rounding) meets none of them.
+bool HierarchicalSolver::chain_clear(const ChainEnds& a, const ChainEnds& b) const {
+    auto left_of = [](Vec2 p, Vec2 q, const Segment& x) {
+        const double chord = norm(q - p);
+        auto strictly = [&](Vec2 v) {
+            return orient(p, q, v) > 64 * std::numeric_limits<double>::epsilon() * chord * (norm(v - p) + chord);
+        };
+        return chord > 0 && strictly(x.a) && strictly(x.b);
+    };
+    for (const Segment& x : m_chain_blockers)
+        if (!left_of(a.a, b.b, x) && !left_of(b.a, a.b, x)) return false;
+    return true;
 }
 
 // The ends of n's chain, oriented with the room on the left; false when n
@@ -841,7 +874,7 @@ bool HierarchicalSolver::make_link(int r, int s, Link& l, VisibilityStats& st) c
         // cluster is a chain (an arc sees itself): a chain link, split only
         // when its error asks (refine).
         ChainEnds a;
-        if (m_chains && nr.cluster() && chain_ends(nr, a)) {
+        if (m_chains && nr.cluster() && chain_ends(nr, a) && chain_clear(a, a)) {
             double rounding = 0;
             const double et = chain_self_etendue(a.a, a.b, nr.length, rounding);
             l.uniform = true;
@@ -904,7 +937,7 @@ bool HierarchicalSolver::make_link(int r, int s, Link& l, VisibilityStats& st) c
         // where the point approximation never holds): a chain link, its
         // etendue exact, the sender's mean spread evenly on the receiver.
         ChainEnds a, b;
-        if (m_chains && chain_ends(nr, a) && chain_ends(ns, b) && a.loop == b.loop) {
+        if (m_chains && chain_ends(nr, a) && chain_ends(ns, b) && a.loop == b.loop && chain_clear(a, b)) {
             double rounding = 0;
             const double et = chain_etendue(a.a, a.b, b.a, b.b, rounding);
             l.uniform = true;

@@ -58,8 +58,9 @@
 ///    element links).
 ///    Overlapping nodes (d <= rho_r + rho_s, or an element whose line cuts
 ///    the cluster's box) are always split when they carry light, except
-///    chain links: where nothing can block, two arcs of one convex loop lit
-///    on the room's side (neighbours along a curved wall) exchange their
+///    chain links: two arcs of one convex loop lit on the room's side
+///    (neighbours along a curved wall) whose hull no segment meets (in
+///    rooms holding at most 64 segments that may block) exchange their
 ///    exact etendue (crossed strings on their chords; an arc with itself:
 ///    its length minus its chord), the sender's mean spread evenly on the
 ///    receiver, with the power they carry at the sender's highest value as
@@ -112,7 +113,7 @@
 namespace flatrad {
 
 struct HierarchicalOptions {
-    double eps = 3e-3;       ///< relative refinement tolerance (see above), > 0; 3e-3: ~1% error
+    double eps = 3e-3;       ///< relative refinement tolerance (see above), > 0; 3e-3: 0.06-0.2% L2 error on the data scenes, 0.1: 0.4-1.2%
     double vis_eps = -1;     ///< absolute tolerance on F for visibility; < 0: eps / 10
     int max_depth = 12;      ///< deepest element level (a patch is level 0)
     int max_passes = 8;      ///< refine-solve rounds at most

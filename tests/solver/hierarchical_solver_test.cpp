@@ -249,7 +249,7 @@ TEST_CASE("hierarchical solver: review regressions (lit sides of a loop seeing i
 }
 
 TEST_CASE("hierarchical solver: data/default.json and data/tube_bank.json at the default eps, against exact") {
-    // The default eps is meant to give about 1% error. On default.json
+    // The default eps is meant to stay well inside 1% error. On default.json
     // cluster links used to carry 13-23% too little light (the pillar's own
     // segments blocking its arcs' stand-ins, one tau for a whole patch):
     // relative L2 6.4e-3, balance 2.1e-2. On tube_bank.json a box-diagonal
@@ -379,7 +379,34 @@ TEST_CASE("hierarchical solver: chain links along a round room: fewer links, the
     CHECK(worst <= furnace_tol);
     CHECK(w.stats.iterations <= 100);
 
-    // Scenes with blockers make none (a chain link carries its etendue
-    // unoccluded).
+    // A few segments inside (a lamp; a plate hugging the wall, 2e-3 from
+    // it over ~30 walls): chain links are made only between arcs whose
+    // hull none of them meets (chain_clear), and the error against exact
+    // is the one without chain links (the ratio bar; measured equal to 3
+    // digits). The default eps's bar holds for the lamp alone (1.3e-3);
+    // the slit behind the plate has 6.6e-3 with or without chain links
+    // (against K = 2, whose own error there is not known), so it is held
+    // to the ratio only. More than max_chain_blockers segments: none at
+    // all (a chain link carries its etendue unoccluded).
+    for (const char* inside : {R"({"name": "lamp", "material": "l", "side": "left", "points": [[0.2, 0.95], [-0.2, 0.95]]})",
+                               R"({"name": "lamp", "material": "l", "side": "left", "points": [[0.2, 0.95], [-0.2, 0.95]]},
+                                  {"name": "plate", "material": "w", "side": "both", "points": [[0.998, -0.05], [0.998, 0.05]]})"}) {
+        const Scene s = parse_scene(fmt::format(R"({{"flatrad": 1, "materials": {{"w": {{"reflectance": 0.5}},
+            "l": {{"reflectance": 0.5, "emission": 1}}}}, "surfaces": [
+            {{"name": "wall", "material": "w", "side": "in", "circle": {{"center": [0, 0], "radius": 1, "segments": 1000}}}},
+            {}]}})",
+                                                inside),
+                                    "inside.json");
+        const Solution ci = solve_hierarchical(s, with), pi = solve_hierarchical(s, without);
+        const Solution ei = solve_exact(s, {2, 0});
+        const double eci = relative_l2(s, ci, ei), epi = relative_l2(s, pi, ei);
+        MESSAGE("1000-wall ring with ", s.surfaces.size() - 1, " inside: L2 ", eci, " with chain links (", ci.stats.links,
+                " links, ", ci.stats.chain_links, " chain), ", epi, " without (", pi.stats.links, ")");
+        CHECK(ci.stats.chain_links > 0);
+        CHECK(ci.stats.links < pi.stats.links);
+        CHECK(eci <= same_error_ratio * epi);
+        if (s.surfaces.size() == 2) CHECK(eci <= l2_bar);
+    }
     CHECK(solve_hierarchical(load_scene(FLATRAD_DATA_DIR "/default.json")).stats.chain_links == 0);
+    CHECK(solve_hierarchical(load_scene(FLATRAD_DATA_DIR "/forest.json")).stats.chain_links == 0);
 }
