@@ -2179,7 +2179,8 @@ Solution HierarchicalSolver::run() {
         refine(leaf_guess());
         solve();
         for (int pass = 1; pass < m_opt.max_passes; ++pass) {
-            collect_leaves();
+            // (The leaves and operator nodes are the ones solve() collected:
+            // nothing splits between a solve and the next refinement.)
             std::vector<double> bmax(static_cast<size_t>(m_element_leaves), 0.0);
             for (size_t i = 0; i < bmax.size(); ++i)
                 for (int c = 0; c < m_C; ++c)
