@@ -226,7 +226,8 @@ struct ChainEnds {
 // evaluated by engine/formfactor.h's stable form (a few ulps of the
 // chords' lengths; `rounding` gets 16 of them). An arc with itself (r = s,
 // length L): L F_rr = L - |a0 a1| (what leaves the arc and does not cross
-// its chord); L is a sum over its walls, counted at 64 ulps.
+// its chord); L is summed up the cluster tree (one rounding per level, and
+// trees are far shallower than 64 levels), counted at 64 ulps.
 // (tests/engine/formfactor_test.cpp checks both against the sum of every
 // pair of walls' form factors.)
 double chain_etendue(Vec2 a0, Vec2 a1, Vec2 b0, Vec2 b1, double& rounding) {

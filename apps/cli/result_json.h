@@ -30,8 +30,11 @@ nlohmann::ordered_json result_json(const Scene& scene, const Solution& solution)
 std::string format_result(const nlohmann::ordered_json& result);
 
 /// format_result(result_json(scene, solution)), written straight from the
-/// solution: the same text, without a DOM of every patch (at 10^6 patches
-/// the DOM took 3.5 s and ~1 GB; this ~0.5 s).
+/// solution: the same JSON value and layout, without a DOM of every patch
+/// (at 10^6 patches the DOM took 3.5 s and ~1 GB; this ~0.5 s). Doubles
+/// get the shortest digits that read back to them (std::to_chars), where
+/// nlohmann's grisu2 sometimes prints a 17th: the values are the same bits,
+/// the text may be a digit shorter.
 std::string result_text(const Scene& scene, const Solution& solution);
 
 }  // namespace flatrad

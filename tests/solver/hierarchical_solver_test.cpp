@@ -386,8 +386,9 @@ TEST_CASE("hierarchical solver: chain links along a round room: fewer links, the
     // digits). The default eps's bar holds for the lamp alone (1.3e-3);
     // the slit behind the plate has 6.6e-3 with or without chain links
     // (against K = 2, whose own error there is not known), so it is held
-    // to the ratio only. More than max_chain_blockers segments: none at
-    // all (a chain link carries its etendue unoccluded).
+    // to the ratio only. More than max_chain_blockers (64) segments that
+    // may block (the lamp counts): none at all (a chain link carries its
+    // etendue unoccluded).
     for (const char* inside : {R"({"name": "lamp", "material": "l", "side": "left", "points": [[0.2, 0.95], [-0.2, 0.95]]})",
                                R"({"name": "lamp", "material": "l", "side": "left", "points": [[0.2, 0.95], [-0.2, 0.95]]},
                                   {"name": "plate", "material": "w", "side": "both", "points": [[0.998, -0.05], [0.998, 0.05]]})"}) {
@@ -408,5 +409,26 @@ TEST_CASE("hierarchical solver: chain links along a round room: fewer links, the
         if (s.surfaces.size() == 2) CHECK(eci <= l2_bar);
     }
     CHECK(solve_hierarchical(load_scene(FLATRAD_DATA_DIR "/default.json")).stats.chain_links == 0);
-    CHECK(solve_hierarchical(load_scene(FLATRAD_DATA_DIR "/forest.json")).stats.chain_links == 0);
+    // A round room of 400 walls with its lamp and 64 short plates inside
+    // (65 segments that may block: one more than max_chain_blockers), and
+    // the same with 63 plates: none, then some.
+    for (int plates : {64, 63}) {
+        std::string inside;
+        for (int k = 0; k < plates; ++k) {
+            const double x = -0.6 + 1.2 * (k % 8) / 7, y = -0.6 + 1.2 * (k / 8) / 8;
+            inside += fmt::format(R"(, {{"name": "p{}", "material": "w", "side": "both", "points": [[{},{}],[{},{}]]}})", k,
+                                  x, y, x + 0.02, y + 0.01);
+        }
+        const Scene s = parse_scene(fmt::format(R"({{"flatrad": 1, "materials": {{"w": {{"reflectance": 0.5}},
+            "l": {{"reflectance": 0.5, "emission": 1}}}}, "surfaces": [
+            {{"name": "wall", "material": "w", "side": "in", "circle": {{"center": [0, 0], "radius": 1, "segments": 400}}}},
+            {{"name": "lamp", "material": "l", "side": "left", "points": [[0.2, 0.95], [-0.2, 0.95]]}}{}]}})",
+                                                inside),
+                                    "plates.json");
+        CAPTURE(plates);
+        if (plates == 64)
+            CHECK(solve_hierarchical(s).stats.chain_links == 0);
+        else
+            CHECK(solve_hierarchical(s).stats.chain_links > 0);
+    }
 }
