@@ -22,6 +22,7 @@
 
 #include "engine/geometry.h"
 #include "engine/hierarchy.h"
+#include "visibility/direction_bounds.h"
 #include "visibility/stats.h"
 
 namespace flatrad {
@@ -36,6 +37,7 @@ struct ExactWorkspace {
     std::vector<double> proj;
     std::vector<int32_t> order;
     std::vector<double> soa;
+    DirectionBoundsScratch bounds;  // visibility/direction_bounds.h (multi-scale queries)
 };
 
 class ExactVisibility {

@@ -13,6 +13,7 @@ struct VisibilityStats {
     long events = 0;            ///< critical directions integrated over
     long separated = 0;         ///< shafts or sub-shafts closed by one blocker (answer 0 at once)
     long subshafts = 0;         ///< shafts split in two because they held many blockers
+    long bounded = 0;           ///< answered by direction bounds within the tolerance (direction_bounds.h)
 
     VisibilityStats& operator+=(const VisibilityStats& o) {
         queries += o.queries;
@@ -24,6 +25,7 @@ struct VisibilityStats {
         events += o.events;
         separated += o.separated;
         subshafts += o.subshafts;
+        bounded += o.bounded;
         return *this;
     }
 };

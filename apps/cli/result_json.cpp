@@ -150,6 +150,7 @@ ordered_json visibility_stats_json(const VisibilityStats& s) {
     j["events"] = s.events;
     j["separated"] = s.separated;
     j["subshafts"] = s.subshafts;
+    j["bounded"] = s.bounded;
     return j;
 }
 

@@ -6,6 +6,7 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "engine/formfactor.h"
@@ -74,7 +75,7 @@ TEST_CASE("multiscale: eps = 0 approximates nothing and is exact, on 200 random 
 
 TEST_CASE("multiscale: the reported error bound holds (rule: bound), and F -> exact as eps -> 0") {
     std::mt19937_64 rng(23);
-    int checked = 0, approximated = 0, failures = 0;
+    int checked = 0, approximated = 0, bounded = 0, failures = 0;
     const double eps_list[] = {0.1, 0.03, 0.01, 3e-3, 1e-3, 1e-4};
     double sum_err[6] = {};
     for (int t = 0; t < 120; ++t) {
@@ -90,8 +91,10 @@ TEST_CASE("multiscale: the reported error bound holds (rule: bound), and F -> ex
         const double unocc = form_factor_unoccluded(c.i, c.j);
         size_t e_index = 0;
         for (double eps : eps_list) {
+            const long bounded_before = st.bounded;
             const MultiscaleResult r = ms.form_factor(c.i, c.j, 0, 1, eps, GammaRule::Bound, ws, st);
             ++checked;
+            if (st.bounded > bounded_before) ++bounded;
             if (r.clusters_approximated > 0) ++approximated;
             const double err = std::abs(r.F - exact);
             sum_err[e_index++] += err;
@@ -102,9 +105,10 @@ TEST_CASE("multiscale: the reported error bound holds (rule: bound), and F -> ex
             CHECK(r.F >= 0);
         }
     }
-    MESSAGE(checked << " (configuration, eps) pairs, " << approximated << " with approximations, " << failures
-                    << " bound failures");
+    MESSAGE(checked << " (configuration, eps) pairs, " << approximated << " with approximations, " << bounded
+                    << " answered by direction bounds, " << failures << " bound failures");
     CHECK(failures == 0);
+    CHECK(bounded > checked / 10);  // and direction bounds
     CHECK(approximated > checked / 4);  // the test exercises approximation
     // F -> exact as eps -> 0: the summed error falls from the loosest to the
     // tightest eps, by more than 10x.
@@ -205,6 +209,7 @@ TEST_CASE("multiscale: below the piece threshold nothing is approximated and F i
         const MultiscaleResult loose = ms.form_factor(c.i, c.j, 0, 1, 0.1, GammaRule::Bound, ws, st);
         if (loose.clusters_approximated > 0) ++was_approximated;
         ms.set_min_pieces_to_approximate(1000000);
+        ms.set_min_pieces_to_bound(std::numeric_limits<size_t>::max());  // no direction bounds either
         const MultiscaleResult r = ms.form_factor(c.i, c.j, 0, 1, 0.1, GammaRule::Bound, ws, st);
         CAPTURE(t);
         CHECK(r.clusters_approximated == 0);
@@ -212,6 +217,7 @@ TEST_CASE("multiscale: below the piece threshold nothing is approximated and F i
         CHECK(std::abs(r.F - exact) <= exact_tol * std::max(exact, 1e-300));
         // Back to 0: the same approximations as before.
         ms.set_min_pieces_to_approximate(0);
+        ms.set_min_pieces_to_bound(32);
         CHECK(ms.form_factor(c.i, c.j, 0, 1, 0.1, GammaRule::Bound, ws, st).clusters_approximated ==
               loose.clusters_approximated);
     }

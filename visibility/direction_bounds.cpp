@@ -1,0 +1,161 @@
+#include "visibility/direction_bounds.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "engine/compensated_sum.h"
+#include "visibility/shaft.h"
+
+namespace flatrad {
+
+namespace {
+
+using Interval = DirectionBoundsScratch::Interval;
+using Bin = DirectionBoundsScratch::Bin;
+
+// Bins the range starts with: enough to see where the shadows' ends are.
+constexpr int initial_bins = 8;
+
+// Length of w left by the union of `shadows` (each sorted or not).
+double free_length(Interval w, std::vector<Interval>& shadows) {
+    if (!(w.b > w.a)) return 0;
+    std::sort(shadows.begin(), shadows.end(), [](const Interval& x, const Interval& y) { return x.a < y.a; });
+    double covered = 0, reach = w.a;
+    for (const Interval& s : shadows) {
+        const double a = std::max(s.a, reach), b = std::min(s.b, w.b);
+        if (b > a) {
+            covered += b - a;
+            reach = b;
+        }
+        if (reach >= w.b) break;
+    }
+    return std::max(0.0, (w.b - w.a) - covered);
+}
+
+struct Evaluator {
+    const std::vector<Vec2>& pts;     // shaft-centred frame: A0 A1 C0 C1, then pieces' ends
+    const std::vector<double>& radius;  // |P| of each
+    std::vector<Interval>& shadows;
+
+    // lower and upper bounds of free(phi) over [c - h, c + h].
+    void operator()(Bin& bin) const {
+        const double nx = -std::sin(bin.c), ny = std::cos(bin.c);
+        auto p = [&](size_t k) { return nx * pts[k].x + ny * pts[k].y; };
+        auto d = [&](size_t k) { return radius[k] * bin.h; };
+        // The interval between points k and k + 1 at some direction of the
+        // bin: always inside `wide`, always containing `narrow` (if any).
+        auto wide = [&](size_t k) {
+            const double p0 = p(k), p1 = p(k + 1), d0 = d(k), d1 = d(k + 1);
+            return Interval{std::min(p0 - d0, p1 - d1), std::max(p0 + d0, p1 + d1)};
+        };
+        auto narrow = [&](size_t k) {
+            const double p0 = p(k), p1 = p(k + 1), d0 = d(k), d1 = d(k + 1);
+            return Interval{std::min(p0 + d0, p1 + d1), std::max(p0 - d0, p1 - d1)};
+        };
+        const Interval ai = wide(0), aj = wide(2), ni = narrow(0), nj = narrow(2);
+        const Interval window_wide{std::max(ai.a, aj.a), std::min(ai.b, aj.b)};
+        const Interval window_narrow{std::max(ni.a, nj.a), std::min(ni.b, nj.b)};
+        const size_t pieces = (pts.size() - 4) / 2;
+        // Fewest free lines: the narrow window, wide shadows.
+        shadows.clear();
+        for (size_t q = 0; q < pieces; ++q) {
+            const Interval s = wide(4 + 2 * q);
+            if (s.b > window_narrow.a && s.a < window_narrow.b) shadows.push_back(s);
+        }
+        bin.lower = free_length(window_narrow, shadows);
+        // Most: the wide window, narrow shadows.
+        shadows.clear();
+        for (size_t q = 0; q < pieces; ++q) {
+            const Interval s = narrow(4 + 2 * q);
+            if (s.b > s.a && s.b > window_wide.a && s.a < window_wide.b) shadows.push_back(s);
+        }
+        bin.upper = free_length(window_wide, shadows);
+        bin.lower = std::min(bin.lower, bin.upper);
+    }
+};
+
+// The bin whose gap h (upper - lower) is largest on top.
+bool smaller_gap(const Bin& x, const Bin& y) { return x.h * (x.upper - x.lower) < y.h * (y.upper - y.lower); }
+
+}  // namespace
+
+DirectionBounds direction_bounds(const Segment& ci, const Segment& cj, const Segment* pieces, size_t count,
+                                 double tol, long max_evaluations, DirectionBoundsScratch& ws) {
+    DirectionBounds out;
+    const shaft_detail::PairFrame frame(ci, cj);
+    auto& pts = ws.points;
+    pts.clear();
+    for (Vec2 P : {ci.a, ci.b, cj.a, cj.b}) pts.push_back(frame.local(P));
+    for (size_t q = 0; q < count; ++q) {
+        pts.push_back(frame.local(pieces[q].a));
+        pts.push_back(frame.local(pieces[q].b));
+    }
+    // The range of directions (frame angle), as the exact integral takes it.
+    double s_lo = std::numeric_limits<double>::infinity(), s_hi = -s_lo;
+    for (size_t a = 0; a < 2; ++a)
+        for (size_t c = 2; c < 4; ++c) {
+            const Vec2 w = pts[c] - pts[a];
+            if (w == Vec2{} || !(w.x > 0)) continue;
+            s_lo = std::min(s_lo, w.y / w.x);
+            s_hi = std::max(s_hi, w.y / w.x);
+        }
+    if (!(s_hi > s_lo)) {
+        out.converged = true;
+        return out;
+    }
+    const double phi_lo = std::atan(s_lo), phi_hi = std::atan(s_hi);
+    // Rotate about the centre of the patches' box: the smallest drifts.
+    Box box;
+    for (size_t k = 0; k < 4; ++k) box.add(pts[k]);
+    const Vec2 centre = box.center();
+    auto& radius = ws.radius;
+    radius.resize(pts.size());
+    for (size_t k = 0; k < pts.size(); ++k) {
+        pts[k] = pts[k] - centre;
+        radius[k] = norm(pts[k]);
+    }
+
+    const Evaluator eval{pts, radius, ws.intervals};
+    auto& bins = ws.bins;
+    bins.clear();
+    const double h0 = (phi_hi - phi_lo) / (2 * initial_bins);
+    double lo = 0, hi = 0;
+    for (int b = 0; b < initial_bins; ++b) {
+        Bin bin{phi_lo + (2 * b + 1) * h0, h0, 0, 0};
+        eval(bin);
+        ++out.evaluations;
+        lo += bin.h * bin.lower;
+        hi += bin.h * bin.upper;
+        bins.push_back(bin);
+    }
+    std::make_heap(bins.begin(), bins.end(), smaller_gap);
+    while (hi - lo > 2 * tol && out.evaluations + 2 <= max_evaluations) {
+        std::pop_heap(bins.begin(), bins.end(), smaller_gap);
+        const Bin worst = bins.back();
+        bins.pop_back();
+        lo -= worst.h * worst.lower;
+        hi -= worst.h * worst.upper;
+        for (double side : {-0.5, 0.5}) {
+            Bin half{worst.c + side * worst.h, 0.5 * worst.h, 0, 0};
+            eval(half);
+            ++out.evaluations;
+            lo += half.h * half.lower;
+            hi += half.h * half.upper;
+            bins.push_back(half);
+            std::push_heap(bins.begin(), bins.end(), smaller_gap);
+        }
+    }
+    // The sums again, compensated, from the bins themselves (the running
+    // ones above only steer the refinement).
+    CompensatedSum l, u;
+    for (const Bin& b : bins) {
+        l.add(b.h * b.lower);
+        u.add(b.h * b.upper);
+    }
+    out.lo = std::max(0.0, l.value());
+    out.hi = std::max(out.lo, u.value());
+    out.converged = out.hi - out.lo <= 2 * tol;
+    return out;
+}
+
+}  // namespace flatrad
