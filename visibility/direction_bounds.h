@@ -48,9 +48,13 @@ struct DirectionBoundsScratch {
     std::vector<Bin> bins;
 };
 
+/// Bins every call starts with (equal, over the whole range of directions).
+inline constexpr int direction_bounds_initial_bins = 16;
+
 /// Bounds on L_i F_ij for a mutually clipped facing pair (ci, cj), lit on the
 /// left, with `count` blocker pieces inside its shaft, refined until
-/// hi - lo <= 2 tol or `max_evaluations` bins have been evaluated.
+/// hi - lo <= 2 tol or `max_evaluations` bins have been evaluated (at least
+/// the initial ones).
 DirectionBounds direction_bounds(const Segment& ci, const Segment& cj, const Segment* pieces, size_t count,
                                  double tol, long max_evaluations, DirectionBoundsScratch& scratch);
 

@@ -78,7 +78,7 @@ TEST_CASE("direction bounds: the exact integral lies between them, and they clos
                                   ": lo ", b.lo, " exact ", exact);
                     CHECK_MESSAGE(b.hi >= exact - rounding_tol * unocc, "n ", n, " len ", len, " budget ", budget,
                                   ": hi ", b.hi, " exact ", exact);
-                    CHECK(b.evaluations <= std::max(budget, 8L));
+                    CHECK(b.evaluations <= std::max<long>(budget, direction_bounds_initial_bins));
                     // Halving bins never widens the bounds (a half's drift is
                     // half its parent's, inside its parent's directions).
                     CHECK(b.hi - b.lo <= previous_gap * (1 + rounding_tol) + rounding_tol * unocc);
@@ -112,7 +112,7 @@ TEST_CASE("direction bounds: a tolerance is met when the budget allows, and said
         CHECK(std::abs(0.5 * (b.lo + b.hi) - exact) <= tol * (1 + rounding_tol));
         const DirectionBounds tight = direction_bounds(c.ci, c.cj, c.pieces.data(), c.pieces.size(), 1e-9 * unocc, 16, scratch);
         CHECK_FALSE(tight.converged);
-        CHECK(tight.evaluations <= 16);
+        CHECK(tight.evaluations <= std::max<long>(16, direction_bounds_initial_bins));
     }
 }
 
