@@ -41,43 +41,43 @@ double free_length(Interval w, std::vector<Interval>& shadows) {
 }
 
 struct Evaluator {
-    const std::vector<Vec2>& pts;     // shaft-centred frame: A0 A1 C0 C1, then pieces' ends
+    const std::vector<Vec2>& pts;       // shaft-centred frame: A0 A1 C0 C1, then pieces' ends
     const std::vector<double>& radius;  // |P| of each
-    std::vector<Interval>& shadows;
+    std::vector<double>& p;             // scratch: projections at the bin's centre
+    std::vector<Interval>& wide_shadows;
+    std::vector<Interval>& narrow_shadows;
 
     // lower and upper bounds of free(phi) over [c - h, c + h].
     void operator()(Bin& bin) const {
-        const double nx = -std::sin(bin.c), ny = std::cos(bin.c);
-        auto p = [&](size_t k) { return nx * pts[k].x + ny * pts[k].y; };
-        auto d = [&](size_t k) { return radius[k] * bin.h; };
-        // The interval between points k and k + 1 at some direction of the
+        const double nx = -std::sin(bin.c), ny = std::cos(bin.c), h = bin.h;
+        const size_t n = pts.size();
+        p.resize(n);
+        for (size_t k = 0; k < n; ++k) p[k] = nx * pts[k].x + ny * pts[k].y;
+        // The interval between points k and k + 1 at any direction of the
         // bin: always inside `wide`, always containing `narrow` (if any).
         auto wide = [&](size_t k) {
-            const double p0 = p(k), p1 = p(k + 1), d0 = d(k), d1 = d(k + 1);
-            return Interval{std::min(p0 - d0, p1 - d1), std::max(p0 + d0, p1 + d1)};
+            const double d0 = radius[k] * h, d1 = radius[k + 1] * h;
+            return Interval{std::min(p[k] - d0, p[k + 1] - d1), std::max(p[k] + d0, p[k + 1] + d1)};
         };
         auto narrow = [&](size_t k) {
-            const double p0 = p(k), p1 = p(k + 1), d0 = d(k), d1 = d(k + 1);
-            return Interval{std::min(p0 + d0, p1 + d1), std::max(p0 - d0, p1 - d1)};
+            const double d0 = radius[k] * h, d1 = radius[k + 1] * h;
+            return Interval{std::min(p[k] + d0, p[k + 1] + d1), std::max(p[k] - d0, p[k + 1] - d1)};
         };
         const Interval ai = wide(0), aj = wide(2), ni = narrow(0), nj = narrow(2);
         const Interval window_wide{std::max(ai.a, aj.a), std::min(ai.b, aj.b)};
         const Interval window_narrow{std::max(ni.a, nj.a), std::min(ni.b, nj.b)};
-        const size_t pieces = (pts.size() - 4) / 2;
-        // Fewest free lines: the narrow window, wide shadows.
-        shadows.clear();
-        for (size_t q = 0; q < pieces; ++q) {
-            const Interval s = wide(4 + 2 * q);
-            if (s.b > window_narrow.a && s.a < window_narrow.b) shadows.push_back(s);
+        // Fewest free lines: the narrow window, wide shadows; most: the
+        // wide window, narrow shadows.
+        wide_shadows.clear();
+        narrow_shadows.clear();
+        for (size_t k = 4; k < n; k += 2) {
+            const Interval sw = wide(k);
+            if (sw.b > window_narrow.a && sw.a < window_narrow.b) wide_shadows.push_back(sw);
+            const Interval sn = narrow(k);
+            if (sn.b > sn.a && sn.b > window_wide.a && sn.a < window_wide.b) narrow_shadows.push_back(sn);
         }
-        bin.lower = free_length(window_narrow, shadows);
-        // Most: the wide window, narrow shadows.
-        shadows.clear();
-        for (size_t q = 0; q < pieces; ++q) {
-            const Interval s = narrow(4 + 2 * q);
-            if (s.b > s.a && s.b > window_wide.a && s.a < window_wide.b) shadows.push_back(s);
-        }
-        bin.upper = free_length(window_wide, shadows);
+        bin.lower = free_length(window_narrow, wide_shadows);
+        bin.upper = free_length(window_wide, narrow_shadows);
         bin.lower = std::min(bin.lower, bin.upper);
     }
 };
@@ -123,7 +123,7 @@ DirectionBounds direction_bounds(const Segment& ci, const Segment& cj, const Seg
         radius[k] = norm(pts[k]);
     }
 
-    const Evaluator eval{pts, radius, ws.intervals};
+    const Evaluator eval{pts, radius, ws.projections, ws.intervals, ws.narrow_intervals};
     auto& bins = ws.bins;
     bins.clear();
     const double h0 = (phi_hi - phi_lo) / (2 * initial_bins);

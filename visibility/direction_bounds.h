@@ -41,7 +41,8 @@ struct DirectionBoundsScratch {
     struct Interval {
         double a, b;
     };
-    std::vector<Interval> intervals;
+    std::vector<Interval> intervals, narrow_intervals;
+    std::vector<double> projections;
     struct Bin {
         double c, h, lower, upper;
     };
