@@ -126,35 +126,27 @@ DirectionBounds direction_bounds(const Segment& ci, const Segment& cj, const Seg
     const Evaluator eval{pts, radius, ws.projections, ws.intervals, ws.narrow_intervals};
     auto& bins = ws.bins;
     bins.clear();
-    const double h0 = (phi_hi - phi_lo) / (2 * initial_bins);
-    double lo = 0, hi = 0;
-    for (int b = 0; b < initial_bins; ++b) {
-        Bin bin{phi_lo + (2 * b + 1) * h0, h0, 0, 0};
+    double lo = 0, hi = 0;  // running sums: they only steer the refinement
+    auto add = [&](Bin bin) {
         eval(bin);
         ++out.evaluations;
         lo += bin.h * bin.lower;
         hi += bin.h * bin.upper;
         bins.push_back(bin);
-    }
-    std::make_heap(bins.begin(), bins.end(), smaller_gap);
+        std::push_heap(bins.begin(), bins.end(), smaller_gap);
+    };
+    const double h0 = (phi_hi - phi_lo) / (2 * initial_bins);
+    for (int b = 0; b < initial_bins; ++b) add({phi_lo + (2 * b + 1) * h0, h0, 0, 0});
     while (hi - lo > 2 * tol && out.evaluations + 2 <= max_evaluations) {
         std::pop_heap(bins.begin(), bins.end(), smaller_gap);
         const Bin worst = bins.back();
         bins.pop_back();
         lo -= worst.h * worst.lower;
         hi -= worst.h * worst.upper;
-        for (double side : {-0.5, 0.5}) {
-            Bin half{worst.c + side * worst.h, 0.5 * worst.h, 0, 0};
-            eval(half);
-            ++out.evaluations;
-            lo += half.h * half.lower;
-            hi += half.h * half.upper;
-            bins.push_back(half);
-            std::push_heap(bins.begin(), bins.end(), smaller_gap);
-        }
+        add({worst.c - 0.5 * worst.h, 0.5 * worst.h, 0, 0});
+        add({worst.c + 0.5 * worst.h, 0.5 * worst.h, 0, 0});
     }
-    // The sums again, compensated, from the bins themselves (the running
-    // ones above only steer the refinement).
+    // The sums again, compensated, from the bins themselves.
     CompensatedSum l, u;
     for (const Bin& b : bins) {
         l.add(b.h * b.lower);
