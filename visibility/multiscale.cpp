@@ -20,7 +20,7 @@ constexpr double infinity = std::numeric_limits<double>::infinity();
 // that its own error stays well below the approximation it serves.
 constexpr double quadrature_share = 1e-3;
 // Direction bounds (1b in form_factor_skipping) are tried in shafts of at
-// least this many pieces, with a budget of bins_per_piece bins per piece
+// least this many pieces, with a budget of bounds_budget_per_piece bins a piece
 // (at least bounds_min_budget). A cost choice: an attempt that does not
 // converge is wasted, one that does replaces an integral of ~n^2 events.
 // Measured on the 1000-segment forest of `scripts/bench versus` (eps 2 /

@@ -10,7 +10,7 @@ struct VisibilityStats {
     long clusters_visited = 0;  ///< hierarchy nodes visited by shaft culling
     long approximated = 0;      ///< clusters replaced by a mean (0 for exact)
     long blockers = 0;          ///< blocker pieces found inside shafts
-    long events = 0;            ///< critical directions integrated over
+    long events = 0;            ///< critical directions integrated over (direction bounds: bins)
     long separated = 0;         ///< shafts or sub-shafts closed by one blocker (answer 0 at once)
     long subshafts = 0;         ///< shafts split in two because they held many blockers
     long bounded = 0;           ///< answered by direction bounds within the tolerance (direction_bounds.h)
