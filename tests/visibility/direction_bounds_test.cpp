@@ -130,3 +130,31 @@ TEST_CASE("direction bounds: an empty shaft is the crossed-strings exchange to t
     CHECK(b.hi >= unocc * (1 - rounding_tol));
     CHECK(b.hi - b.lo <= 2e-4 * unocc);
 }
+
+TEST_CASE("direction bounds: the scene scaled by 1e-6 .. 1e6: the same verdicts, the exact value inside") {
+    // Exchanges scale with length and the bins' directions do not change;
+    // which bin is halved next can differ where two gaps are equal to
+    // rounding, so the bounds themselves may differ, but each pair must
+    // hold the scaled exact value and close within the scaled tolerance.
+    std::mt19937_64 rng(3);
+    DirectionBoundsScratch scratch;
+    ExactWorkspace ws;
+    VisibilityStats st;
+    for (int rep = 0; rep < 10; ++rep) {
+        const Case c = random_case(rng, 50, 0.1);
+        const double unocc = exchange_crossed_strings(c.ci, c.cj);
+        const double exact = ExactVisibility::exchange_with_blockers(c.ci, c.cj, c.pieces, ws, st);
+        for (double s : {1e-6, 1e-3, 1.0, 1e3, 1e6}) {
+            auto scaled = [s](const Segment& g) { return Segment{g.a * s, g.b * s}; };
+            std::vector<Segment> pieces;
+            for (const Segment& p : c.pieces) pieces.push_back(scaled(p));
+            const DirectionBounds b = direction_bounds(scaled(c.ci), scaled(c.cj), pieces.data(), pieces.size(),
+                                                       0.01 * unocc * s, 100000, scratch);
+            CAPTURE(s);
+            CHECK(b.converged);
+            CHECK(b.hi - b.lo <= 0.02 * unocc * s);
+            CHECK(b.lo <= (exact + rounding_tol * unocc) * s);
+            CHECK(b.hi >= (exact - rounding_tol * unocc) * s);
+        }
+    }
+}
