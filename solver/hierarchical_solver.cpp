@@ -62,6 +62,12 @@ constexpr long max_chain_blockers = 64;
 // square of the pieces (1000 pieces: 0.2 s a query, `scripts/bench
 // ffcost`), so very crowded shafts are left to the approximation.
 constexpr size_t min_pieces_to_approximate = 512;
+// Shafts of at least this many pieces are first tried with direction
+// bounds (visibility/direction_bounds.h), which replace the exact integral
+// there when they close within the visibility tolerance: the 1000-segment
+// forest at 1% error in 0.40 s instead of 5.35 s (measurements of the
+// choice in visibility/multiscale.cpp).
+constexpr size_t min_pieces_to_bound = 32;
 
 // GMRES stops at ||E - (I - rho G) B|| <= 1e-12 ||E||: the operator is
 // applied in double with sums of at most a few thousand terms per node, so
@@ -298,6 +304,7 @@ public:
         m_threads = o.threads > 0 ? o.threads : omp_get_max_threads();
         m_vis_eps = o.vis_eps >= 0 ? o.vis_eps : o.eps / 10;
         m_vis.set_min_pieces_to_approximate(min_pieces_to_approximate);
+        m_vis.set_min_pieces_to_bound(min_pieces_to_bound);
 
         // Walls on the scene's hull block nothing (engine/convex_scene.h):
         // visibility skips them; with no blocker at all it is never asked.

@@ -19,13 +19,15 @@ constexpr double infinity = std::numeric_limits<double>::infinity();
 // The direction integral is computed to this share of eps (error in F), so
 // that its own error stays well below the approximation it serves.
 constexpr double quadrature_share = 1e-3;
-// Direction bounds (1b in form_factor_skipping) are tried in shafts of at
-// least this many pieces, with a budget of bounds_budget_per_piece bins a piece
-// (at least bounds_min_budget). A cost choice: an attempt that does not
-// converge is wasted, one that does replaces an integral of ~n^2 events.
-// Measured on the 1000-segment forest of `scripts/bench versus` (eps 2 /
+// Direction bounds (1b in form_factor_skipping), where enabled
+// (set_min_pieces_to_bound), get a budget of bounds_budget_per_piece bins a
+// piece (at least bounds_min_budget). A cost choice: an attempt that does
+// not converge is wasted, one that does replaces an integral of ~n^2
+// events. With the hierarchical solver's settings (from 32 pieces):
+// measured on the 1000-segment forest of `scripts/bench versus` (eps 2 /
 // 1 / 0.5 / 0.1; time in s, relative L2 against exact K = 2; bounds
-// starting from 8 bins, direction_bounds.cpp):
+// from N pieces with B bins a piece, "from N, B", starting from 8 bins,
+// direction_bounds.cpp):
 //   none            5.35 / 6.51 / 7.94 / 10.7 s   8.5e-3 / 5.4e-3 / 3.7e-3 / 1.8e-3
 //   from 32, 0.5    0.42 / 0.68 / 1.03 / 2.34 s   1.8e-2 / 9.9e-3 / 6.3e-3 / 2.2e-3
 //   from 32, 2      0.38 / 0.58 / 0.85 / 1.98 s   1.8e-2 / 1.0e-2 / 6.3e-3 / 2.2e-3
@@ -34,7 +36,6 @@ constexpr double quadrature_share = 1e-3;
 // unused, hence the larger errors at one eps). With 16 starting bins (the
 // default) "from 32, 2" gives 0.43 / 0.63 / 0.91 / 2.04 s at 9.5e-3 /
 // 6.0e-3 / 4.0e-3 / 1.8e-3: at 1% error, 12x faster than none.
-constexpr size_t default_min_pieces_to_bound = 32;
 constexpr long bounds_min_budget = 16;
 constexpr double bounds_budget_per_piece = 2;
 // Depth cap of the adaptive Gauss-Kronrod bisection on one arc.
@@ -611,7 +612,7 @@ std::optional<GammaRule> gamma_rule_from_name(const std::string& name) {
 }
 
 MultiscaleVisibility::MultiscaleVisibility(const Hierarchy& hierarchy, const ClusterTables& tables)
-    : m_hierarchy(&hierarchy), m_tables(&tables), m_min_pieces_to_bound(default_min_pieces_to_bound) {
+    : m_hierarchy(&hierarchy), m_tables(&tables) {
     m_position.assign(hierarchy.segments().size(), -1);
     for (size_t k = 0; k < hierarchy.order().size(); ++k)
         m_position[static_cast<size_t>(hierarchy.order()[k])] = static_cast<int32_t>(k);

@@ -16,8 +16,10 @@
 /// by adaptive Gauss-Kronrod between the critical directions of the exact
 /// part, to 1e-3 eps; its error estimate is added to the bound.
 ///
-/// Before either, a shaft crowded with blocker pieces (32 or more) is tried
-/// with guaranteed bounds by direction bins (direction_bounds.h): the
+/// Before either, where the caller enables it (set_min_pieces_to_bound; the
+/// hierarchical solver does, from 32 pieces), a shaft crowded with blocker
+/// pieces is tried with guaranteed bounds by direction bins
+/// (direction_bounds.h): the
 /// pieces' shadows widened and narrowed by how far they can move within a
 /// bin, bins halved worst first. If the bounds close to within 2 eps within
 /// a budget of bins (2 per piece), their midpoint is the answer and their
@@ -29,6 +31,7 @@
 /// Errors of several approximated clusters add up (for factors in [0, 1],
 /// |prod a - prod b| <= sum |a - b|), so the claimed bound is the sum of the
 /// criteria used. Each cluster is tested against eps alone, as in the paper.
+#include <limits>
 #include <optional>
 #include <string>
 
@@ -141,8 +144,15 @@ public:
     /// solver/hierarchical_solver.cpp, where it is set).
     void set_min_pieces_to_approximate(size_t n) { m_min_pieces = n; }
     /// Try direction bounds (see above) in shafts of at least `n` blocker
-    /// pieces (default 32; SIZE_MAX: never, e.g. for an exact answer below
-    /// set_min_pieces_to_approximate).
+    /// pieces. Off by default (SIZE_MAX). A choice of what the caller
+    /// values: the bounds' midpoint carries an error of the order of the
+    /// tolerance, while the cluster approximation's real error is usually
+    /// far below its bound. On data/soler95-fig5.json's sweep (one form
+    /// factor, 384 pieces) the cluster approximation reaches 1% at eps 0.04,
+    /// 110x faster than exact, the bounds at eps 0.006, 2x faster; in the
+    /// hierarchical solver, where the exact integral is what the bounds
+    /// replace (the cluster approximation is left to shafts of 512 pieces or
+    /// more), they make a 1000-segment forest 14x faster at 1% error.
     void set_min_pieces_to_bound(size_t n) { m_min_pieces_to_bound = n; }
 
 private:
@@ -161,7 +171,7 @@ private:
     const ClusterTables* m_tables;
     std::vector<int32_t> m_position;  // segment number -> index in hierarchy order
     size_t m_min_pieces = 0;
-    size_t m_min_pieces_to_bound;
+    size_t m_min_pieces_to_bound = std::numeric_limits<size_t>::max();
 };
 
 }  // namespace flatrad

@@ -16,7 +16,7 @@ struct CloudVisibility {
 
     const Hierarchy hierarchy;
     const ClusterTables tables;
-    const MultiscaleVisibility multiscale;
+    MultiscaleVisibility multiscale;  // (settable: set_min_pieces_to_bound)
     const ExactVisibility exact;
 };
 

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <string>
 
 #include "engine/formfactor.h"
 #include "support/cloud_visibility.h"
@@ -74,46 +75,58 @@ TEST_CASE("multiscale: eps = 0 approximates nothing and is exact, on 200 random 
 }
 
 TEST_CASE("multiscale: the reported error bound holds (rule: bound), and F -> exact as eps -> 0") {
-    std::mt19937_64 rng(23);
-    int checked = 0, approximated = 0, bounded = 0, failures = 0;
-    const double eps_list[] = {0.1, 0.03, 0.01, 3e-3, 1e-3, 1e-4};
-    double sum_err[6] = {};
-    for (int t = 0; t < 120; ++t) {
-        const test::Cloud c = test::make_cloud(rng);
-        const test::CloudVisibility vis(c);
-        const MultiscaleVisibility& ms = vis.multiscale;
-        const ExactVisibility& ex = vis.exact;
-        ExactWorkspace ws;
-        VisibilityStats st;
-        const double exact = ex.form_factor(c.i, c.j, 0, 1, ws, st);
-        // Floor relative to the unoccluded F: a fully blocked pair has F = 0
-        // but its integral still sums terms of the unoccluded size.
-        const double unocc = form_factor_unoccluded(c.i, c.j);
-        size_t e_index = 0;
-        for (double eps : eps_list) {
-            const long bounded_before = st.bounded;
-            const MultiscaleResult r = ms.form_factor(c.i, c.j, 0, 1, eps, GammaRule::Bound, ws, st);
-            ++checked;
-            if (st.bounded > bounded_before) ++bounded;
-            if (r.clusters_approximated > 0) ++approximated;
-            const double err = std::abs(r.F - exact);
-            sum_err[e_index++] += err;
-            if (err > r.error_bound + rounding_floor * unocc) {
-                ++failures;
-                MESSAGE("bound fails: t=" << t << " eps=" << eps << " err=" << err << " bound=" << r.error_bound);
+    // Twice: as the module comes (cluster approximation) and with direction
+    // bounds in shafts of 32 pieces or more (as the hierarchical solver has it).
+    for (const bool with_bounds : {false, true}) {
+        CAPTURE(with_bounds);
+        std::mt19937_64 rng(23);
+        int checked = 0, approximated = 0, bounded = 0, failures = 0;
+        const double eps_list[] = {0.1, 0.03, 0.01, 3e-3, 1e-3, 1e-4};
+        double sum_err[6] = {};
+        for (int t = 0; t < 120; ++t) {
+            const test::Cloud c = test::make_cloud(rng);
+            test::CloudVisibility vis(c);
+            if (with_bounds) vis.multiscale.set_min_pieces_to_bound(32);
+            const MultiscaleVisibility& ms = vis.multiscale;
+            const ExactVisibility& ex = vis.exact;
+            ExactWorkspace ws;
+            VisibilityStats st;
+            const double exact = ex.form_factor(c.i, c.j, 0, 1, ws, st);
+            // Floor relative to the unoccluded F: a fully blocked pair has F = 0
+            // but its integral still sums terms of the unoccluded size.
+            const double unocc = form_factor_unoccluded(c.i, c.j);
+            size_t e_index = 0;
+            for (double eps : eps_list) {
+                const long bounded_before = st.bounded;
+                const MultiscaleResult r = ms.form_factor(c.i, c.j, 0, 1, eps, GammaRule::Bound, ws, st);
+                ++checked;
+                if (st.bounded > bounded_before) ++bounded;
+                if (r.clusters_approximated > 0) ++approximated;
+                const double err = std::abs(r.F - exact);
+                sum_err[e_index++] += err;
+                if (err > r.error_bound + rounding_floor * unocc) {
+                    ++failures;
+                    MESSAGE("bound fails: t=" << t << " eps=" << eps << " err=" << err << " bound=" << r.error_bound);
+                }
+                CHECK(r.F >= 0);
             }
-            CHECK(r.F >= 0);
         }
+        MESSAGE(std::string(with_bounds ? "with" : "without") << " direction bounds: " << checked << " (configuration, eps) pairs, "
+                << approximated << " with approximations, " << bounded << " answered by direction bounds, "
+                << failures << " bound failures");
+        CHECK(failures == 0);
+        if (with_bounds) {
+            CHECK(bounded > checked / 10);  // the bounds are exercised
+        } else {
+            CHECK(bounded == 0);  // off unless asked for
+            CHECK(approximated > checked / 4);  // the test exercises approximation
+        }
+        // F -> exact as eps -> 0: the summed error falls from the loosest to the
+        // tightest eps, by more than 10x.
+        MESSAGE("summed |F - exact| per eps: " << sum_err[0] << " " << sum_err[2] << " " << sum_err[4] << " "
+                                              << sum_err[5]);
+        CHECK(sum_err[5] * 10 < sum_err[0]);
     }
-    MESSAGE(checked << " (configuration, eps) pairs, " << approximated << " with approximations, " << bounded
-                    << " answered by direction bounds, " << failures << " bound failures");
-    CHECK(failures == 0);
-    CHECK(bounded > checked / 10);  // and direction bounds
-    CHECK(approximated > checked / 4);  // the test exercises approximation
-    // F -> exact as eps -> 0: the summed error falls from the loosest to the
-    // tightest eps, by more than 10x.
-    MESSAGE("summed |F - exact| per eps: " << sum_err[0] << " " << sum_err[2] << " " << sum_err[4] << " " << sum_err[5]);
-    CHECK(sum_err[5] * 10 < sum_err[0]);
 }
 
 TEST_CASE("multiscale: transmittance between clusters is in [0, 1] and within its bound of eps = 0") {
@@ -209,7 +222,6 @@ TEST_CASE("multiscale: below the piece threshold nothing is approximated and F i
         const MultiscaleResult loose = ms.form_factor(c.i, c.j, 0, 1, 0.1, GammaRule::Bound, ws, st);
         if (loose.clusters_approximated > 0) ++was_approximated;
         ms.set_min_pieces_to_approximate(1000000);
-        ms.set_min_pieces_to_bound(std::numeric_limits<size_t>::max());  // no direction bounds either
         const MultiscaleResult r = ms.form_factor(c.i, c.j, 0, 1, 0.1, GammaRule::Bound, ws, st);
         CAPTURE(t);
         CHECK(r.clusters_approximated == 0);
@@ -217,7 +229,6 @@ TEST_CASE("multiscale: below the piece threshold nothing is approximated and F i
         CHECK(std::abs(r.F - exact) <= exact_tol * std::max(exact, 1e-300));
         // Back to 0: the same approximations as before.
         ms.set_min_pieces_to_approximate(0);
-        ms.set_min_pieces_to_bound(32);
         CHECK(ms.form_factor(c.i, c.j, 0, 1, 0.1, GammaRule::Bound, ws, st).clusters_approximated ==
               loose.clusters_approximated);
     }
