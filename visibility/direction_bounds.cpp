@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "engine/compensated_sum.h"
 #include "visibility/shaft.h"
@@ -14,9 +15,9 @@ using Interval = DirectionBoundsScratch::Interval;
 using Bin = DirectionBoundsScratch::Bin;
 
 // Bins the range starts with (direction_bounds.h): enough to see where the
-// shadows' ends are. The refinement then halves the bins with the widest gaps, so a coarse
-// start can close the bounds with some bins still wide, where the midpoint
-// of the bounds is least accurate. Measured on the 1000-segment forest of
+// shadows' ends are. The refinement then halves the bins with the widest
+// gaps, so a coarse start can close the bounds with some bins still wide,
+// where the midpoint of the bounds is least accurate. Measured on the 1000-segment forest of
 // `scripts/bench versus` (eps 2 / 1 / 0.1, medians of 3): 8 bins 0.40 /
 // 0.60 / 2.05 s at relative L2 1.8e-2 / 1.0e-2 / 2.2e-3; 16 bins 0.43 /
 // 0.63 / 2.04 s at 9.5e-3 / 6.0e-3 / 1.8e-3 (the same errors as exact
@@ -24,7 +25,7 @@ using Bin = DirectionBoundsScratch::Bin;
 // 5.5e-3 / 1.8e-3; 4 bins 2.0e-2 at eps 1.
 constexpr int initial_bins = direction_bounds_initial_bins;
 
-// Length of w left by the union of `shadows` (each sorted or not).
+// Length of w left by the union of `shadows` (sorted here by start).
 double free_length(Interval w, std::vector<Interval>& shadows) {
     if (!(w.b > w.a)) return 0;
     std::sort(shadows.begin(), shadows.end(), [](const Interval& x, const Interval& y) { return x.a < y.a; });

@@ -19,14 +19,14 @@
 /// Before either, where the caller enables it (set_min_pieces_to_bound; the
 /// hierarchical solver does, from 32 pieces), a shaft crowded with blocker
 /// pieces is tried with guaranteed bounds by direction bins
-/// (direction_bounds.h): the
-/// pieces' shadows widened and narrowed by how far they can move within a
-/// bin, bins halved worst first. If the bounds close to within 2 eps within
-/// a budget of bins (2 per piece), their midpoint is the answer and their
-/// half-gap the claimed bound (stats.bounded); otherwise the walk goes on as
-/// above. The exact integral of n pieces meets ~n^2 critical directions; a
-/// bin costs a sort of n shadows, and a dense forest covers most of the
-/// window, so few bins are needed.
+/// (direction_bounds.h): the pieces' shadows widened and narrowed by how
+/// far they can move within a bin, bins halved worst first. If the bounds
+/// close to within 2 eps within a budget of bins (2 per piece), their
+/// midpoint is the answer and their half-gap the claimed bound
+/// (stats.bounded); otherwise the walk goes on as above. The exact integral
+/// of n pieces meets ~n^2 critical directions; a bin costs two sorts of n
+/// shadows, and a dense forest covers most of the window, so few bins are
+/// needed.
 ///
 /// Errors of several approximated clusters add up (for factors in [0, 1],
 /// |prod a - prod b| <= sum |a - b|), so the claimed bound is the sum of the
