@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
 #include "engine/compensated_sum.h"
 #include "visibility/shaft.h"
@@ -99,20 +98,13 @@ DirectionBounds direction_bounds(const Segment& ci, const Segment& cj, const Seg
         pts.push_back(frame.local(pieces[q].a));
         pts.push_back(frame.local(pieces[q].b));
     }
-    // The range of directions (frame angle), as the exact integral takes it.
-    double s_lo = std::numeric_limits<double>::infinity(), s_hi = -s_lo;
-    for (size_t a = 0; a < 2; ++a)
-        for (size_t c = 2; c < 4; ++c) {
-            const Vec2 w = pts[c] - pts[a];
-            if (w == Vec2{} || !(w.x > 0)) continue;
-            s_lo = std::min(s_lo, w.y / w.x);
-            s_hi = std::max(s_hi, w.y / w.x);
-        }
-    if (!(s_hi > s_lo)) {
+    // The range of directions of lines meeting both patches, in the frame
+    // (shaft.h): [-delta_theta, delta_theta].
+    const double phi_lo = -frame.delta_theta, phi_hi = frame.delta_theta;
+    if (!(phi_hi > phi_lo)) {
         out.converged = true;
         return out;
     }
-    const double phi_lo = std::atan(s_lo), phi_hi = std::atan(s_hi);
     // Rotate about the centre of the patches' box: the smallest drifts.
     Box box;
     for (size_t k = 0; k < 4; ++k) box.add(pts[k]);
