@@ -757,6 +757,8 @@ MultiscaleResult MultiscaleVisibility::form_factor_skipping(const Segment& i, co
             if (pieces.size() > before) piece_pos.push_back(q);
         }
     }
+    stats.clusters_visited += out.clusters_visited;
+    ++stats.queries;
     // 1b. A crowded shaft, a loose tolerance: bounds by direction bins
     //     (direction_bounds.h) may meet it for much less than the exact
     //     integral or the mixed one; they are tried with a budget.
@@ -765,8 +767,6 @@ MultiscaleResult MultiscaleVisibility::form_factor_skipping(const Segment& i, co
         const DirectionBounds b =
             direction_bounds(g.ci, g.cj, pieces.data(), pieces.size(), eps * g.L_i, budget, ws.bounds);
         if (b.converged) {
-            stats.clusters_visited += out.clusters_visited;
-            ++stats.queries;
             ++stats.bounded;
             stats.events += b.evaluations;
             out.F = 0.5 * (b.lo + b.hi) / g.L_i;
@@ -812,8 +812,6 @@ MultiscaleResult MultiscaleVisibility::form_factor_skipping(const Segment& i, co
             stack.push_back(n.child[0]);
         }
     }
-    stats.clusters_visited += out.clusters_visited;
-    ++stats.queries;
     if (separated) {
         // One exact blocker closes the shaft: 0 whatever was approximated.
         ++stats.separated;

@@ -6,7 +6,6 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
-#include <limits>
 #include <random>
 #include <string>
 
@@ -111,9 +110,10 @@ TEST_CASE("multiscale: the reported error bound holds (rule: bound), and F -> ex
                 CHECK(r.F >= 0);
             }
         }
-        MESSAGE(std::string(with_bounds ? "with" : "without") << " direction bounds: " << checked << " (configuration, eps) pairs, "
-                << approximated << " with approximations, " << bounded << " answered by direction bounds, "
-                << failures << " bound failures");
+        MESSAGE(std::string(with_bounds ? "with" : "without")
+                << " direction bounds: " << checked << " (configuration, eps) pairs, " << approximated
+                << " with approximations, " << bounded << " answered by direction bounds, " << failures
+                << " bound failures");
         CHECK(failures == 0);
         if (with_bounds) {
             CHECK(bounded > checked / 10);  // the bounds are exercised
