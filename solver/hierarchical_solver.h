@@ -36,6 +36,14 @@
 ///    the boxes along the segments, engine/oriented_box.h) the link reads
 ///    and writes that instead, exactly (a curved wall seen from along
 ///    itself); where none faces, the link is dropped.
+///    Members hidden behind others of the same cluster (a forest's
+///    clusters hold many layers of sticks): per table and direction, the
+///    share of the members' lobes seen from outside the cluster
+///    (solver/self_occlusion.h) scales its sensitivity, and level by level
+///    what its children pull up into it and what it pushes down to them
+///    (the same factor both ways: the operator keeps its adjoint). Such a
+///    table's linear part is not read. Not where nothing can block, nor
+///    for chains (arcs of a convex loop whose partners lie inside it).
 ///  - Refinement oracle: a link is split when its estimated error in
 ///    transported power exceeds eps_abs = eps x W / N (W the scene's exitant
 ///    power in the current solution, max over channels; N the patch count:

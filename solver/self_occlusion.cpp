@@ -1,0 +1,88 @@
+#include "solver/self_occlusion.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+namespace flatrad {
+
+void visible_fraction(const Segment* segs, const uint8_t* sides, size_t n, double out[directional_bins], int lines) {
+    std::fill(out, out + directional_bins, 1.0);
+    if (n < 2) return;  // one segment cannot hide itself
+    const int M = lines > 0 ? lines : static_cast<int>(std::clamp<size_t>(8 * n, 64, 2048));
+    const size_t Ms = static_cast<size_t>(M);
+    // Per line: the frontmost blocker's depth and whether its side facing u
+    // exists; how many existing sides facing u the line meets; how many of
+    // those belong to segments that cannot block and lie in front.
+    thread_local std::vector<double> depth;
+    thread_local std::vector<uint8_t> front;
+    thread_local std::vector<int32_t> count, passive;
+    depth.resize(Ms);
+    front.resize(Ms);
+    count.resize(Ms);
+    passive.resize(Ms);
+    const auto& dirs = bin_directions();
+    for (int k = 0; k < directional_bins; ++k) {
+        const Vec2 u = dirs[static_cast<size_t>(k)];
+        const Vec2 v{-u.y, u.x};  // across the lines
+        double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+        for (size_t i = 0; i < n; ++i) {
+            const double pa = dot(segs[i].a, v), pb = dot(segs[i].b, v);
+            lo = std::min({lo, pa, pb});
+            hi = std::max({hi, pa, pb});
+        }
+        const double w = (hi - lo) / M;
+        if (!(w > 0)) continue;  // every segment along u: nothing faces it
+        std::fill(depth.begin(), depth.end(), -std::numeric_limits<double>::infinity());
+        std::fill(front.begin(), front.end(), uint8_t{0});
+        std::fill(count.begin(), count.end(), 0);
+        std::fill(passive.begin(), passive.end(), 0);
+        // Blockers first (the depth buffer), then the segments that cannot
+        // block: seen where in front of the frontmost blocker.
+        for (int pass = 0; pass < 2; ++pass) {
+            for (size_t i = 0; i < n; ++i) {
+                const bool blocker = (sides[i] & blocks) != 0;
+                if (blocker != (pass == 0)) continue;
+                const Segment& s = segs[i];
+                // The side facing u, if it exists (a segment along u faces
+                // nothing and covers a line's centre only by rounding).
+                const double c = dot(s.left_normal(), u);
+                const uint8_t side = c > 0 ? left_side : c < 0 ? right_side : 0;
+                const bool facing = (sides[i] & side) != 0;
+                if (!blocker && !facing) continue;
+                double pa = dot(s.a, v), pb = dot(s.b, v), da = dot(s.a, u), db = dot(s.b, u);
+                if (pa > pb) {
+                    std::swap(pa, pb);
+                    std::swap(da, db);
+                }
+                // Lines j, at lo + (j + 1/2) w, within [pa, pb].
+                const int j0 = std::max(0, static_cast<int>(std::ceil((pa - lo) / w - 0.5)));
+                const int j1 = std::min(M - 1, static_cast<int>(std::floor((pb - lo) / w - 0.5)));
+                const double span = pb - pa;
+                for (int j = j0; j <= j1; ++j) {
+                    const size_t js = static_cast<size_t>(j);
+                    const double t = span > 0 ? (lo + (j + 0.5) * w - pa) / span : 0.5;
+                    const double d = da + t * (db - da);
+                    if (facing) ++count[js];
+                    if (pass == 0) {
+                        if (d > depth[js]) {
+                            depth[js] = d;
+                            front[js] = facing ? 1 : 0;
+                        }
+                    } else if (d >= depth[js]) {
+                        ++passive[js];
+                    }
+                }
+            }
+        }
+        long seen = 0, all = 0;
+        for (size_t j = 0; j < Ms; ++j) {
+            seen += front[j] + passive[j];
+            all += count[j];
+        }
+        if (all > 0) out[k] = static_cast<double>(seen) / static_cast<double>(all);
+    }
+}
+
+}  // namespace flatrad

@@ -1,0 +1,51 @@
+#pragma once
+/// Occlusion inside a cluster: how much of its members' sensitivity is seen
+/// from outside it (DESIGN.md §3, "cluster senders and receivers need a
+/// directional model").
+///
+/// A cluster's directional tables sum its members' cosine lobes, L cos+(n .
+/// u): the sensitivity N(psi) and the exitance I(phi). That sum counts every
+/// side facing a direction, also a side behind another member of the same
+/// cluster, which no light from outside reaches and whose light never
+/// leaves (a forest of blockers: a cluster of a hundred sticks holds tens
+/// of layers). Transmittances between clusters skip the two clusters' own
+/// contents (visibility/multiscale.h), so nothing else counts this loss:
+/// without it a cluster link gives every hidden member its full share, and
+/// the solution absorbs more than is emitted.
+///
+/// visible_fraction() measures, per direction bin, the share of the lobe
+/// sum that is seen from far along that direction: a 1D visible-surface
+/// problem (the frontmost segment per line across the cluster), solved on
+/// a grid of lines across the set's extent, as a depth buffer. Seen from a
+/// link's other end the lines are not parallel; this is the cluster's own
+/// point approximation, whose error the link's error estimate carries.
+#include <cstddef>
+#include <cstdint>
+
+#include "engine/geometry.h"
+#include "solver/directional.h"
+
+namespace flatrad {
+
+/// Which sides of a segment exist (receive and send): bit 0 its left side
+/// (engine/geometry.h's left normal), bit 1 its right side; bit 2 whether
+/// the segment can block light at all (engine/hierarchy.h's set_blockers:
+/// a wall on the scene's hull stands between nothing, and hides nothing).
+inline constexpr uint8_t left_side = 1, right_side = 2, blocks = 4;
+
+/// Per direction bin k (directional.h's u_k): the fraction of sum over
+/// existing sides of L cos+(n . u_k) that lies on sides not hidden, along
+/// u_k, by another of the `n` segments: along each line of direction u_k,
+/// seen from +u_k, the frontmost blocking segment is seen (whether or not
+/// its side exists, it hides what lies behind), and so is every segment
+/// that cannot block in front of it. 1 where no segment's projection
+/// overlaps another's, and where nothing faces u_k.
+///
+/// Measured on `lines` equally spaced lines across the set's extent
+/// (each counts the sides it meets): a share is exact to about one line's
+/// width per visible run. With lines = 0, 8 per segment, at least 64 and
+/// at most 2048. Cost: per bin, n plus lines times the mean depth in layers.
+void visible_fraction(const Segment* segs, const uint8_t* sides, size_t n, double out[directional_bins],
+                      int lines = 0);
+
+}  // namespace flatrad
