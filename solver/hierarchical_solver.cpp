@@ -1328,9 +1328,11 @@ void HierarchicalSolver::pull_tables(const double* leaf_value, std::vector<doubl
                 power += m_op[static_cast<size_t>(c)].length * Bn[static_cast<size_t>(c)];
             Bn[k] = power / n.length;
         }
+        // A table is whole once its children are in: scaled for what its
+        // own members hide (also a part's top, whose links read it).
+        if (n.kind == Kind::Cluster && n.table >= 0) scale_by_beta(I, n.table);
         if (n.kind != Kind::Cluster || n.up_table < 0 || !in_part(part, static_cast<int>(k), n.parent)) continue;
         if (n.table >= 0) {
-            scale_by_beta(I, n.table);
             I.sum_child(n.up_table, n.table);
         } else if (n.leaf_cluster) {
             double* samples = I.samples(n.up_table);

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <numbers>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "engine/scene.h"
@@ -209,4 +210,57 @@ TEST_CASE("hierarchical solver: a forest's clusters no longer deliver light to t
     REQUIRE(s.totals.balance.size() == 1);
     CHECK(s.totals.balance[0] <= balance_bound);
     CHECK(s.totals.absorbed[0] > 0);
+}
+
+TEST_CASE("hierarchical solver: two forests solved apart and together, with hidden members, agree") {
+    // Two closed rooms of random two-sided sticks (clusters several layers
+    // deep), each with a lamp: independent parts. Solving them apart reads
+    // and pushes each part's tables from its own top; together, from the
+    // root: the visible-share factors must apply the same way in both.
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> U(0, 1);
+    std::string surfaces;
+    for (int room = 0; room < 2; ++room) {
+        const double x0 = 3.0 * room;
+        surfaces += R"({"name": "room)" + std::to_string(room) + R"(", "material": "wall", "closed": true, "side": "in", "points": [[)" +
+                    std::to_string(x0) + ",0],[" + std::to_string(x0 + 2) + ",0],[" + std::to_string(x0 + 2) + ",2],[" +
+                    std::to_string(x0) + R"(,2]]},)";
+        surfaces += R"({"name": "lamp)" + std::to_string(room) + R"(", "material": "lamp", "side": "right", "points": [[)" +
+                    std::to_string(x0 + 0.8) + ",1.95],[" + std::to_string(x0 + 1.2) + R"(,1.95]]},)";
+        std::vector<Segment> sticks;
+        while (sticks.size() < 60) {
+            const Vec2 c{x0 + 0.2 + 1.6 * U(rng), 0.2 + 1.5 * U(rng)};
+            const double a = 2 * std::numbers::pi * U(rng);
+            const Vec2 d{0.06 * std::cos(a), 0.06 * std::sin(a)};
+            const Segment s{c - d, c + d};
+            if (std::any_of(sticks.begin(), sticks.end(), [&](const Segment& q) { return meet(s, q); })) continue;
+            sticks.push_back(s);
+            surfaces += R"({"name": "s)" + std::to_string(room) + "_" + std::to_string(sticks.size()) +
+                        R"(", "material": "tree", "side": "both", "points": [[)" + std::to_string(s.a.x) + "," +
+                        std::to_string(s.a.y) + "],[" + std::to_string(s.b.x) + "," + std::to_string(s.b.y) + "]]},";
+        }
+    }
+    surfaces.pop_back();
+    const std::string text = R"({"flatrad": 1, "materials": {"wall": {"reflectance": 0.7}, "tree": {"reflectance": 0.5},
+        "lamp": {"emission": 10}}, "surfaces": [)" + surfaces + "]}";
+    const Scene scene = parse_scene(text, "two_forests.json");
+    HierarchicalOptions apart, together;
+    apart.eps = together.eps = 0.5;  // loose: cluster links to deep clusters survive
+    together.solve_parts_apart = false;
+    const Solution a = solve_hierarchical(scene, apart);
+    const Solution t = solve_hierarchical(scene, together);
+    CHECK(a.stats.independent_parts == 2);
+    CHECK(t.stats.independent_parts == 1);
+    CHECK(a.stats.cluster_links > 0);
+    CHECK(a.stats.links == t.stats.links);
+    // As in light_parts_test.cpp: GMRES's 1e-12 residual in either run, an
+    // inverse of norm ~10 at these reflectances: 1e-9 of the largest.
+    constexpr double same_solution_tol = 1e-9;
+    double worst = 0, largest = 0;
+    for (size_t p = 0; p < scene.patches.size(); ++p) {
+        worst = std::max(worst, std::abs(a.patches[p].radiosity[0] - t.patches[p].radiosity[0]));
+        largest = std::max(largest, std::abs(t.patches[p].radiosity[0]));
+    }
+    REQUIRE(largest > 0);
+    CHECK(worst <= same_solution_tol * largest);
 }
