@@ -443,7 +443,7 @@ private:
     bool m_chains = false;       // some cluster is a chain and few things can block: chain links are made
     bool m_few_blockers = false;  // at most max_chain_blockers segments may block
     std::vector<Segment> m_chain_blockers;  // those segments (chain_clear)
-    std::vector<double> m_Bmax;  // refine: per node, the highest leaf value below (chain links' error)
+    std::vector<double> m_Bmax;  // refine: per node, the highest leaf value below (link_error)
     std::vector<int> m_patch_root;  // per patch: its element tree's root node
 
     std::vector<Node> m_nodes;
@@ -1377,9 +1377,15 @@ LinkError HierarchicalSolver::link_error(const Link& l, const std::vector<double
         if (geometry_only) return {power * kvar, size_r >= size_s};
         // A partly hidden sender may put a shadow boundary anywhere on the
         // receiver; a sink absorbs all it gets, wherever on it, so there
-        // only the accuracy of F itself counts.
+        // only the accuracy of F itself counts. The shadow boundary may
+        // also cross the sender, which sends its mean: its brightest part
+        // may be the one in view (a shelf's top lit beside a book standing
+        // on it, dark underneath), so that share is counted at the
+        // sender's highest leaf value. On data/furnished_room.json the
+        // solution's energy balance at eps 1e-3 went from 1.3e-3 to 1.0e-3
+        // for 0.5% more links; forests did not change.
         const double occlusion = r.sink() ? 0.0 : std::max(0.0, std::min<double>(l.coef, l.Fu - l.coef));
-        double err = power * (kvar + occlusion + l.vis_err);
+        double err = power * (kvar + l.vis_err) + m_Bmax[static_cast<size_t>(l.s)] * r.length * occlusion;
         // The link spreads the sender's mean, not its halves' values.
         if (s.child >= 0) {
             const size_t a = static_cast<size_t>(s.child);
@@ -1559,8 +1565,9 @@ bool HierarchicalSolver::refine(const std::vector<double>& leaf_bmax) {
     TableArray& I = m_I;
     I.reset_full(m_tables_count);  // new links may read any table's samples (pull_tables zeroes them)
     pull_tables(leaf_bmax.data(), Bn, I);
-    if (m_chains) {
-        // The highest leaf value below each node (chain links' error).
+    {
+        // The highest leaf value below each node (chain links' error, an
+        // element sender's bright part behind a shadow boundary).
         m_Bmax.assign(m_nodes.size(), 0.0);
         for (size_t k = m_nodes.size(); k-- > 0;) {
             const OpNode& n = m_op[k];
@@ -1710,8 +1717,7 @@ bool HierarchicalSolver::refine(const std::vector<double>& leaf_bmax) {
             if (m_nodes[static_cast<size_t>(node)].kind == Kind::Element) {
                 split_element(node);
                 while (Bn.size() < m_nodes.size()) Bn.push_back(Bn[static_cast<size_t>(node)]);  // halves start at the mean
-                if (m_chains)
-                    while (m_Bmax.size() < m_nodes.size()) m_Bmax.push_back(m_Bmax[static_cast<size_t>(node)]);
+                while (m_Bmax.size() < m_nodes.size()) m_Bmax.push_back(m_Bmax[static_cast<size_t>(node)]);
             }
             children_links(l, split_r, fresh);
         }

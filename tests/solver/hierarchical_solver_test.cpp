@@ -153,6 +153,30 @@ TEST_CASE("hierarchical solver: converges to the exact solver as eps shrinks") {
     }
 }
 
+TEST_CASE("hierarchical solver: the closed data scenes' energy balance is within 1e-4 at eps 1e-5") {
+    // The issue's balance bar, on every closed scene of data/ (in a closed
+    // room nothing escapes: |emitted - absorbed| / emitted is the transport's
+    // own energy error). data/default.json meets it from eps 1e-4 (the test
+    // above); closed_box and furnished_room only from 1e-5 (1.9e-4 and
+    // 2.6e-4 at 1e-4, 1.2e-4 at 3e-5): an element sender's mean crosses the
+    // books' 1 mm gaps over the shelves, and many links each within eps
+    // add up on one element.
+    constexpr double balance_tol = 1e-4;
+    constexpr double eps = 1e-5;
+    for (const char* name : {"closed_box", "furnished_room", "stiff_room"}) {
+        CAPTURE(name);
+        const Scene scene = load_scene(fmt::format("{}/{}.json", FLATRAD_DATA_DIR, name));
+        HierarchicalOptions o;
+        o.eps = eps;
+        const Solution h = solve_hierarchical(scene, o);
+        for (int c = 0; c < scene.channels; ++c) {
+            CAPTURE(c);
+            CHECK(h.totals.escaped[static_cast<size_t>(c)] == 0.0);
+            CHECK(h.totals.balance[static_cast<size_t>(c)] <= balance_tol);
+        }
+    }
+}
+
 TEST_CASE("hierarchical solver: pays for what the scene uses (DESIGN.md §4)") {
     // A closed convex room: nothing can block, so no visibility query at all.
     const Scene convex = parse_scene(R"({"flatrad": 1, "materials": {"w": {"reflectance": 0.6},
