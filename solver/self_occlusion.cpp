@@ -7,10 +7,72 @@
 
 namespace flatrad {
 
+namespace {
+
+// Exactly, for few segments: per facing side, its interval across u minus
+// the overlaps with blockers in front of it (segments that do not cross:
+// which of two is in front is the same all over their overlap, so its
+// midpoint decides). O(n^2) per direction.
+void visible_fraction_exact(const Segment* segs, const uint8_t* sides, size_t n, double out[directional_bins]) {
+    struct Proj {
+        double lo, hi, dlo, dhi;
+        bool facing, blocker;
+    };
+    thread_local std::vector<Proj> pr;
+    thread_local std::vector<std::pair<double, double>> hidden;
+    pr.resize(n);
+    const auto& dirs = bin_directions();
+    for (int k = 0; k < directional_bins; ++k) {
+        const Vec2 u = dirs[static_cast<size_t>(k)];
+        const Vec2 v{-u.y, u.x};
+        for (size_t i = 0; i < n; ++i) {
+            const Segment& s = segs[i];
+            double pa = dot(s.a, v), pb = dot(s.b, v), da = dot(s.a, u), db = dot(s.b, u);
+            if (pa > pb) {
+                std::swap(pa, pb);
+                std::swap(da, db);
+            }
+            const double c = dot(s.left_normal(), u);
+            const uint8_t side = c > 0 ? left_side : c < 0 ? right_side : 0;
+            pr[i] = {pa, pb, da, db, (sides[i] & side) != 0, (sides[i] & blocks) != 0};
+        }
+        auto depth_at = [](const Proj& q, double p) {
+            return q.hi > q.lo ? q.dlo + (p - q.lo) / (q.hi - q.lo) * (q.dhi - q.dlo) : std::max(q.dlo, q.dhi);
+        };
+        double seen = 0, all = 0;
+        for (size_t i = 0; i < n; ++i) {
+            const Proj& a = pr[i];
+            if (!a.facing || !(a.hi > a.lo)) continue;
+            all += a.hi - a.lo;
+            hidden.clear();
+            for (size_t j = 0; j < n; ++j) {
+                const Proj& b = pr[j];
+                if (j == i || !b.blocker) continue;
+                const double lo = std::max(a.lo, b.lo), hi = std::min(a.hi, b.hi);
+                if (!(hi > lo)) continue;
+                const double mid = 0.5 * (lo + hi);
+                if (depth_at(b, mid) > depth_at(a, mid)) hidden.emplace_back(lo, hi);
+            }
+            std::sort(hidden.begin(), hidden.end());
+            double at = a.lo, covered = 0;
+            for (const auto& [lo, hi] : hidden) {
+                if (hi <= at) continue;
+                covered += hi - std::max(lo, at);
+                at = hi;
+            }
+            seen += a.hi - a.lo - covered;
+        }
+        if (all > 0) out[k] = std::clamp(seen / all, 0.0, 1.0);
+    }
+}
+
+}  // namespace
+
 void visible_fraction(const Segment* segs, const uint8_t* sides, size_t n, double out[directional_bins], int lines) {
     std::fill(out, out + directional_bins, 1.0);
     if (n < 2) return;  // one segment cannot hide itself
-    const int M = lines > 0 ? lines : static_cast<int>(std::clamp<size_t>(8 * n, 64, 2048));
+    if (lines == 0 && n <= exact_up_to) return visible_fraction_exact(segs, sides, n, out);
+    const int M = lines > 0 ? lines : static_cast<int>(std::clamp<size_t>(2 * n, 64, 1024));
     const size_t Ms = static_cast<size_t>(M);
     // Per line: the frontmost blocker's depth and whether its side facing u
     // exists; how many existing sides facing u the line meets; how many of

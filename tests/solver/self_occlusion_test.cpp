@@ -167,9 +167,10 @@ TEST_CASE("visible fraction: random non-crossing sticks against the exact interv
             const double r = U(rng);
             sides.push_back(r < 0.6 ? two_sided : r < 0.8 ? (left_side | blocks) : r < 0.9 ? right_side : two_sided);
         }
-        double f[directional_bins];
+        double f[directional_bins], auto_f[directional_bins];
         const int lines = 4096;
         visible_fraction(segs.data(), sides.data(), segs.size(), f, lines);
+        visible_fraction(segs.data(), sides.data(), segs.size(), auto_f);  // exact up to exact_up_to segments
         for (int k = 0; k < directional_bins; ++k) {
             const Vec2 u = dirs[static_cast<size_t>(k)];
             const Exact e = exact_fraction(segs, sides, u);
@@ -190,6 +191,10 @@ TEST_CASE("visible fraction: random non-crossing sticks against the exact interv
             CAPTURE(k);
             CHECK(std::abs(f[k] - e.fraction) <= tol);
             CHECK(f[k] <= 1.0);
+            // The exact path: the same intervals, summed in another order
+            // (rounding of a few hundred lengths of order 1).
+            constexpr double exact_tol = 1e-12;
+            if (segs.size() <= exact_up_to) CHECK(std::abs(auto_f[k] - e.fraction) <= exact_tol);
             ++compared;
         }
     }
