@@ -62,7 +62,8 @@ void visible_fraction_exact(const Segment* segs, const uint8_t* sides, size_t n,
             }
             seen += a.hi - a.lo - covered;
         }
-        if (all > 0) out[k] = std::clamp(seen / all, 0.0, 1.0);
+        const double share = seen / all;
+        if (all > 0 && std::isfinite(share)) out[k] = std::clamp(share, 0.0, 1.0);  // else unmeasured: 1
     }
 }
 
@@ -95,7 +96,9 @@ void visible_fraction(const Segment* segs, const uint8_t* sides, size_t n, doubl
             hi = std::max({hi, pa, pb});
         }
         const double w = (hi - lo) / M;
-        if (!(w > 0)) continue;  // every segment along u: nothing faces it
+        // Every segment along u (nothing faces it), or an extent past the
+        // largest double (coordinates near 1e308): left at 1, unmeasured.
+        if (!(w > 0) || !std::isfinite(w)) continue;
         std::fill(depth.begin(), depth.end(), -std::numeric_limits<double>::infinity());
         std::fill(front.begin(), front.end(), uint8_t{0});
         std::fill(count.begin(), count.end(), 0);

@@ -146,6 +146,30 @@ TEST_CASE("visible fraction: closed forms on two segments") {
     }
 }
 
+TEST_CASE("visible fraction: extreme coordinates and degenerate segments give shares in [0, 1]") {
+    // Stacked sticks scaled to 1e308 (their lengths and extents overflow to
+    // infinity, their normals to NaN), to 1e-300 (underflow), and a
+    // zero-length segment: every share finite and within [0, 1], by both
+    // paths (what cannot be measured is left at 1).
+    for (double scale : {1e308, 1e-300, 1.0}) {
+        CAPTURE(scale);
+        std::vector<Segment> segs{{{-scale, 0}, {scale, 0}}, {{-scale, 0.01 * scale}, {scale, 0.01 * scale}},
+                                  {{0, 0.005 * scale}, {0, 0.005 * scale}}};
+        for (int k = 0; k < 30; ++k)
+            segs.push_back({{-scale, (2 + k) * scale * 0.01}, {scale * 0.9, (2 + k) * scale * 0.01}});
+        const std::vector<uint8_t> sides(segs.size(), two_sided);
+        for (size_t n : {size_t{3}, segs.size()}) {  // the exact path, the lines
+            double f[directional_bins];
+            visible_fraction(segs.data(), sides.data(), n, f);
+            for (int k = 0; k < directional_bins; ++k) {
+                CHECK(std::isfinite(f[k]));
+                CHECK(f[k] >= 0.0);
+                CHECK(f[k] <= 1.0);
+            }
+        }
+    }
+}
+
 TEST_CASE("visible fraction: random non-crossing sticks against the exact interval oracle") {
     std::mt19937 rng(11);
     std::uniform_real_distribution<double> U(0, 1);
