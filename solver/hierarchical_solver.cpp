@@ -1497,7 +1497,7 @@ LinkError HierarchicalSolver::link_error(const Link& l, const std::vector<double
     //    share of the power is counted (an estimate, not a bound). Counting
     //    half of it, or none, gave more error for the time on the
     //    1000-segment forest (eps 4: 1.0e-2 / 1.3e-2 against 8.9e-3, at the
-    //    same time), twice as much no less.
+    //    same time); counting twice as much gave no less.
     const Vec2 u = (r.center - s.center) / dist;
     auto layered = [&](const Node& c, BinWeight b) {
         const std::vector<double>& all = m_sensitivity_all.empty() ? m_sensitivity : m_sensitivity_all;
