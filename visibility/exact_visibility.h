@@ -23,6 +23,7 @@
 #include "engine/geometry.h"
 #include "engine/hierarchy.h"
 #include "visibility/direction_bounds.h"
+#include "visibility/opaque_band.h"
 #include "visibility/stats.h"
 
 namespace flatrad {
@@ -38,6 +39,7 @@ struct ExactWorkspace {
     std::vector<int32_t> order;
     std::vector<double> soa;
     DirectionBoundsScratch bounds;  // visibility/direction_bounds.h (multi-scale queries)
+    OpaqueBandScratch band;         // visibility/opaque_band.h (multi-scale queries)
 };
 
 class ExactVisibility {

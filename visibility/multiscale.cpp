@@ -7,6 +7,7 @@
 #include "engine/error.h"
 #include "engine/formfactor.h"
 #include "visibility/direction_bounds.h"
+#include "visibility/opaque_band.h"
 #include "visibility/shaft.h"
 
 namespace flatrad {
@@ -759,7 +760,19 @@ MultiscaleResult MultiscaleVisibility::form_factor_skipping(const Segment& i, co
     }
     stats.clusters_visited += out.clusters_visited;
     ++stats.queries;
-    // 1b. A crowded shaft, a loose tolerance: bounds by direction bins
+    // 1b. A crowded shaft may be closed: a band of its pieces across it can
+    //     show that for a few small sorts (opaque_band.h), exactly.
+    if (!separated && pieces.size() >= m_min_pieces_to_prove_closed) {
+        auto& whole = ws.band.blockers;  // the pieces' segments, unclipped
+        whole.clear();
+        for (const int32_t q : piece_pos)
+            whole.push_back(m_hierarchy->segments()[static_cast<size_t>(m_hierarchy->order()[static_cast<size_t>(q)])]);
+        if (band_closes_shaft(g.ci, g.cj, whole.data(), whole.size(), ws.band)) {
+            ++stats.opaque;
+            return out;
+        }
+    }
+    //     A crowded shaft, a loose tolerance: bounds by direction bins
     //     (direction_bounds.h) may meet it for much less than the exact
     //     integral or the mixed one; they are tried with a budget.
     if (!separated && eps > 0 && pieces.size() >= m_min_pieces_to_bound) {

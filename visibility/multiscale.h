@@ -154,6 +154,12 @@ public:
     /// replace (the cluster approximation is left to shafts of 512 pieces or
     /// more), they make a 1000-segment forest 14x faster at 1% error.
     void set_min_pieces_to_bound(size_t n) { m_min_pieces_to_bound = n; }
+    /// Try to prove a shaft of at least `n` blocker pieces closed by a band
+    /// of its pieces across it (opaque_band.h) before anything else: an
+    /// exact 0 when it succeeds (stats.opaque), at any eps. Off by default
+    /// (SIZE_MAX): a failed attempt is wasted, and pays only where many
+    /// crowded shafts are closed (dense forests).
+    void set_min_pieces_to_prove_closed(size_t n) { m_min_pieces_to_prove_closed = n; }
 
 private:
     std::optional<TransmittanceResult> transmittance_between(const Segment& sa, const Segment& sb, int skip_a,
@@ -172,6 +178,7 @@ private:
     std::vector<int32_t> m_position;  // segment number -> index in hierarchy order
     size_t m_min_pieces = 0;
     size_t m_min_pieces_to_bound = std::numeric_limits<size_t>::max();
+    size_t m_min_pieces_to_prove_closed = std::numeric_limits<size_t>::max();
 };
 
 }  // namespace flatrad

@@ -14,6 +14,7 @@ struct VisibilityStats {
     long separated = 0;         ///< shafts or sub-shafts closed by one blocker (answer 0 at once)
     long subshafts = 0;         ///< shafts split in two because they held many blockers
     long bounded = 0;           ///< answered by direction bounds within the tolerance (direction_bounds.h)
+    long opaque = 0;            ///< shafts shown closed by a band of pieces across them (opaque_band.h)
 
     VisibilityStats& operator+=(const VisibilityStats& o) {
         queries += o.queries;
@@ -26,6 +27,7 @@ struct VisibilityStats {
         separated += o.separated;
         subshafts += o.subshafts;
         bounded += o.bounded;
+        opaque += o.opaque;
         return *this;
     }
 };

@@ -151,6 +151,7 @@ ordered_json visibility_stats_json(const VisibilityStats& s) {
     j["separated"] = s.separated;
     j["subshafts"] = s.subshafts;
     j["bounded"] = s.bounded;
+    j["opaque"] = s.opaque;
     return j;
 }
 
