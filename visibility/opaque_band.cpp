@@ -51,6 +51,10 @@ bool covers(const Section& section, Bin bin, OpaqueBandScratch& ws) {
     return false;
 }
 
+// The y at depth t of the line through p and q (a side of the shaft, whose
+// ends lie on either side of every depth between the patches).
+double y_at(double t, Vec2 p, Vec2 q) { return p.y + (t - p.x) / (q.x - p.x) * (q.y - p.y); }
+
 }  // namespace
 
 bool band_closes_shaft(const Segment& ci, const Segment& cj, const Segment* blockers, size_t count,
@@ -93,10 +97,7 @@ bool band_closes_shaft(const Segment& ci, const Segment& cj, const Segment* bloc
         // few in all, no band closes the shaft and the attempt is skipped.
         double across = 0;
         for (size_t q = 0; q < n; ++q) across += std::abs(local[2 * q + 1].y - local[2 * q].y);
-        const auto width_at = [&](double t) {
-            auto cross_at = [t](Vec2 p, Vec2 q) { return p.y + (t - p.x) / (q.x - p.x) * (q.y - p.y); };
-            return std::abs(cross_at(A1, C0) - cross_at(C1, A0));
-        };
+        const auto width_at = [&](double t) { return std::abs(y_at(t, A1, C0) - y_at(t, C1, A0)); };
         const double mean_width = 0.5 * (width_at(xi) + width_at(xj));
         if (!(across >= opaque_band_min_layers * mean_width)) return false;
     }
@@ -124,10 +125,9 @@ bool band_closes_shaft(const Segment& ci, const Segment& cj, const Segment* bloc
         const double t0 = xi + (xj - xi) * (slot + 0.5) / opaque_band_count;
         // The shaft's sides are the edges A1 -> C0 and C1 -> A0, the only
         // two that cross x = t for t between the patches.
-        auto cross_at = [](double t, Vec2 p, Vec2 q) { return p.y + (t - p.x) / (q.x - p.x) * (q.y - p.y); };
-        const bool side1_low = cross_at(t0, A1, C0) <= cross_at(t0, C1, A0);
-        auto low_side = [&](double t) { return side1_low ? cross_at(t, A1, C0) : cross_at(t, C1, A0); };
-        auto high_side = [&](double t) { return side1_low ? cross_at(t, C1, A0) : cross_at(t, A1, C0); };
+        const bool side1_low = y_at(t0, A1, C0) <= y_at(t0, C1, A0);
+        auto low_side = [&](double t) { return side1_low ? y_at(t, A1, C0) : y_at(t, C1, A0); };
+        auto high_side = [&](double t) { return side1_low ? y_at(t, C1, A0) : y_at(t, A1, C0); };
         const double ya = low_side(t0), yb = high_side(t0);
         // Pieces nearest in depth, until their shadows across the axis add
         // up to opaque_band_layers times the section X (or to
@@ -224,6 +224,7 @@ bool band_closes_shaft(const Segment& ci, const Segment& cj, const Segment* bloc
     if (!(h_band > 0)) return false;
     const double bins_wanted = std::max<double>(opaque_band_initial_bins, std::ceil(delta / h_band));
     if (!(bins_wanted <= opaque_band_max_bins)) return false;  // too costly (or not finite)
+    if (bins_wanted * static_cast<double>(band_first[1]) > opaque_band_max_checks) return false;
     const int bins = static_cast<int>(bins_wanted);
     const double h = delta / bins;
     for (int b = 0; b < bins; ++b) {
