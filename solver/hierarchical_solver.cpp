@@ -74,10 +74,10 @@ constexpr size_t min_pieces_to_bound = 32;
 // closes them (visibility/opaque_band.h): an exact 0 where the bounds'
 // midpoint would claim up to the tolerance. In a forest the many nearly
 // opaque links each carried that bias, and it added up: the 10^4-segment
-// forest at eps 1 absorbed 12% more than it emitted, now 0.2%, in 12%
-// more time and 21% fewer links (the 1000-segment forest: 9% more
-// instructions, relative L2 8.94e-3 -> 8.76e-3 at eps 4; tenth session's
-// figures in the README).
+// forest at eps 1 absorbed 12% more than it emitted, now 0.2%, in the same
+// time (10.9 s against 11.1 s) with 20% fewer links; at eps 0.1 18% faster
+// (the 1000-segment forest: 1.4% more instructions, relative L2 8.94e-3
+// -> 8.77e-3 at eps 4; tenth session's figures in the README).
 constexpr size_t min_pieces_to_prove_closed = 32;
 
 // GMRES stops at ||E - (I - rho G) B|| <= 1e-12 ||E||: the operator is
