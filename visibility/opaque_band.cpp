@@ -30,6 +30,10 @@ bool covers(const Section& section, Bin bin, OpaqueBandScratch& ws) {
     auto proj = [&](size_t k) { return nx * P[k].x + ny * P[k].y; };
     // Lines across the section (points 0, 1), above the lower side at the
     // band's outer depths (points 2, 3), below the upper side there (4, 5).
+    // The section's own ends are widened too: the sections tile X at the
+    // bin's centre direction only, and elsewhere in the bin a line through
+    // a boundary between two sections can fall outside both unwidened
+    // windows.
     Interval window{std::min(proj(0) - R[0] * h, proj(1) - R[1] * h), std::max(proj(0) + R[0] * h, proj(1) + R[1] * h)};
     for (const size_t k : {size_t{2}, size_t{3}}) window.a = std::max(window.a, proj(k) - R[k] * h);
     for (const size_t k : {size_t{4}, size_t{5}}) window.b = std::min(window.b, proj(k) + R[k] * h);
