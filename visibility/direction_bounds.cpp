@@ -55,14 +55,8 @@ struct Evaluator {
         for (size_t k = 0; k < n; ++k) p[k] = nx * pts[k].x + ny * pts[k].y;
         // The interval between points k and k + 1 at any direction of the
         // bin: always inside `wide`, always containing `narrow` (if any).
-        auto wide = [&](size_t k) {
-            const double d0 = radius[k] * h, d1 = radius[k + 1] * h;
-            return Interval{std::min(p[k] - d0, p[k + 1] - d1), std::max(p[k] + d0, p[k + 1] + d1)};
-        };
-        auto narrow = [&](size_t k) {
-            const double d0 = radius[k] * h, d1 = radius[k + 1] * h;
-            return Interval{std::min(p[k] + d0, p[k + 1] + d1), std::max(p[k] - d0, p[k + 1] - d1)};
-        };
+        auto wide = [&](size_t k) { return swept(p[k], radius[k] * h, p[k + 1], radius[k + 1] * h); };
+        auto narrow = [&](size_t k) { return held(p[k], radius[k] * h, p[k + 1], radius[k + 1] * h); };
         const Interval ai = wide(0), aj = wide(2), ni = narrow(0), nj = narrow(2);
         const Interval window_wide{std::max(ai.a, aj.a), std::min(ai.b, aj.b)};
         const Interval window_narrow{std::max(ni.a, nj.a), std::min(ni.b, nj.b)};

@@ -21,6 +21,7 @@
 /// Exact integral: O(n^2) critical directions or more. This: O(n log n)
 /// per bin, and a dense forest's window is mostly covered (few shadow ends
 /// in it), so few bins. Neither samples: the bounds hold, up to rounding.
+#include <algorithm>
 #include <cstddef>
 #include <vector>
 
@@ -34,13 +35,28 @@ struct DirectionBounds {
     bool converged = false; ///< hi - lo <= 2 tol reached within the budget
 };
 
+/// An interval of line offsets n(phi) . P along a bin's normal.
+struct OffsetInterval {
+    double a, b;
+};
+
+/// The drift bound (above), for a segment whose ends are at offsets p and
+/// q at the bin's centre and move by at most dp and dq within the bin:
+/// swept() holds every offset the segment covers at some direction of the
+/// bin; held() is covered at every direction of it (empty, b <= a, when
+/// no offset is). Shared by the bounds here and opaque_band.h.
+inline OffsetInterval swept(double p, double dp, double q, double dq) {
+    return {std::min(p - dp, q - dq), std::max(p + dp, q + dq)};
+}
+inline OffsetInterval held(double p, double dp, double q, double dq) {
+    return {std::min(p + dp, q + dq), std::max(p - dp, q - dq)};
+}
+
 /// Scratch memory of one thread.
 struct DirectionBoundsScratch {
     std::vector<Vec2> points;
     std::vector<double> radius;
-    struct Interval {
-        double a, b;
-    };
+    using Interval = OffsetInterval;
     std::vector<Interval> intervals, narrow_intervals;
     std::vector<double> projections;
     struct Bin {

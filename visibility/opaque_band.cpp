@@ -34,15 +34,14 @@ bool covers(const Section& section, Bin bin, OpaqueBandScratch& ws) {
     // bin's centre direction only, and elsewhere in the bin a line through
     // a boundary between two sections can fall outside both unwidened
     // windows.
-    Interval window{std::min(proj(0) - R[0] * h, proj(1) - R[1] * h), std::max(proj(0) + R[0] * h, proj(1) + R[1] * h)};
+    Interval window = swept(proj(0), R[0] * h, proj(1), R[1] * h);
     for (const size_t k : {size_t{2}, size_t{3}}) window.a = std::max(window.a, proj(k) - R[k] * h);
     for (const size_t k : {size_t{4}, size_t{5}}) window.b = std::min(window.b, proj(k) + R[k] * h);
     if (!(window.b > window.a)) return window.b <= window.a;  // no line to stop; false if not finite
     auto& shadows = ws.shadows;
     shadows.clear();
     for (size_t k = section_head; k + 1 < section.count; k += 2) {
-        const double p = proj(k), q = proj(k + 1), dp = R[k] * h, dq = R[k + 1] * h;
-        const Interval s{std::min(p + dp, q + dq), std::max(p - dp, q - dq)};
+        const Interval s = held(proj(k), R[k] * h, proj(k + 1), R[k + 1] * h);
         if (s.b > s.a && s.b > window.a && s.a < window.b) shadows.push_back(s);
     }
     std::sort(shadows.begin(), shadows.end(), [](const Interval& x, const Interval& y) { return x.a < y.a; });

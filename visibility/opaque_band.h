@@ -34,14 +34,13 @@
 #include <vector>
 
 #include "engine/geometry.h"
+#include "visibility/direction_bounds.h"
 
 namespace flatrad {
 
 /// Scratch memory of one thread.
 struct OpaqueBandScratch {
-    struct Interval {
-        double a, b;
-    };
+    using Interval = OffsetInterval;
     struct Bin {
         double c, h;
     };
