@@ -14,6 +14,7 @@ namespace flatrad {
 
 using namespace shaft_detail;
 
+
 namespace {
 
 constexpr double infinity = std::numeric_limits<double>::infinity();
@@ -760,15 +761,30 @@ MultiscaleResult MultiscaleVisibility::form_factor_skipping(const Segment& i, co
     }
     stats.clusters_visited += out.clusters_visited;
     ++stats.queries;
-    // 1b. A crowded shaft may be closed: a band of its pieces across it can
-    //     show that for a few small sorts (opaque_band.h), exactly.
+    // 1b. A crowded shaft: bands of its pieces across it (opaque_band.h)
+    //     may show it closed (exactly 0) or, with a tolerance, bound its
+    //     exchange within it, for a few small sorts. The bound's midpoint is
+    //     the answer, as for the direction bounds below.
     if (!separated && pieces.size() >= m_min_pieces_to_prove_closed) {
         auto& whole = ws.band.blockers;  // the pieces' segments, unclipped
         whole.clear();
         for (const int32_t q : piece_pos)
             whole.push_back(m_hierarchy->segments()[static_cast<size_t>(m_hierarchy->order()[static_cast<size_t>(q)])]);
-        if (band_closes_shaft(g.ci, g.cj, whole.data(), whole.size(), ws.band)) {
+        BandOptions band;  // eps = 0: the proof of closure alone
+        if (eps > 0) {
+            band.limit = 2 * eps * g.L_i;
+            band.drift = band_bound_drift;
+            band.max_checks = band_bound_max_checks;
+        }
+        const double upper = band_bound(g.ci, g.cj, whole.data(), whole.size(), band, ws.band);
+        if (upper == 0) {
             ++stats.opaque;
+            return out;
+        }
+        if (upper <= band.limit) {
+            ++stats.banded;
+            out.F = 0.5 * upper / g.L_i;
+            out.error_bound = 0.5 * upper / g.L_i;
             return out;
         }
     }
@@ -781,7 +797,6 @@ MultiscaleResult MultiscaleVisibility::form_factor_skipping(const Segment& i, co
             direction_bounds(g.ci, g.cj, pieces.data(), pieces.size(), eps * g.L_i, budget, ws.bounds);
         if (b.converged) {
             ++stats.bounded;
-            stats.events += b.evaluations;
             out.F = 0.5 * (b.lo + b.hi) / g.L_i;
             out.error_bound = 0.5 * (b.hi - b.lo) / g.L_i;
             return out;

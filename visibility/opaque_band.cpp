@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "visibility/shaft.h"
 
@@ -10,66 +11,131 @@ namespace flatrad {
 namespace {
 
 using Interval = OpaqueBandScratch::Interval;
-using Bin = OpaqueBandScratch::Bin;
-using Section = OpaqueBandScratch::Section;  // points [first, first + count) of the scratch
+using Band = OpaqueBandScratch::Band;
 
-// Points of a section before its pieces' ends: its own two ends, then two
-// points of the lower side and two of the upper (covers()).
-constexpr size_t section_head = 6;
+constexpr double not_shown = std::numeric_limits<double>::infinity();
 
-// Whether the section's pieces stop every line that crosses the section, at
-// every direction of [c - h, c + h], among the lines that stay inside the
-// shaft over the band's depths. Each point's offset n(phi) . P (about the
-// section's midpoint) is within |P| h of its value at c; the lines to stop
-// are widened by that, each piece's shadow narrowed by it (what it shadows
-// at every direction of the bin). Anything not finite leaves it uncovered.
-bool covers(const Section& section, Bin bin, OpaqueBandScratch& ws) {
-    const double nx = -std::sin(bin.c), ny = std::cos(bin.c), h = bin.h;
-    const Vec2* P = ws.points.data() + section.first;
-    const double* R = ws.radius.data() + section.first;
-    auto proj = [&](size_t k) { return nx * P[k].x + ny * P[k].y; };
-    // Lines across the section (points 0, 1), above the lower side at the
-    // band's outer depths (points 2, 3), below the upper side there (4, 5).
-    // The section's own ends are widened too: the sections tile X at the
-    // bin's centre direction only, and elsewhere in the bin a line through
-    // a boundary between two sections can fall outside both unwidened
-    // windows.
-    Interval window = swept(proj(0), R[0] * h, proj(1), R[1] * h);
-    for (const size_t k : {size_t{2}, size_t{3}}) window.a = std::max(window.a, proj(k) - R[k] * h);
-    for (const size_t k : {size_t{4}, size_t{5}}) window.b = std::min(window.b, proj(k) + R[k] * h);
-    if (!(window.b > window.a)) return window.b <= window.a;  // no line to stop; false if not finite
-    auto& shadows = ws.shadows;
-    shadows.clear();
-    for (size_t k = section_head; k + 1 < section.count; k += 2) {
-        const Interval s = held(proj(k), R[k] * h, proj(k + 1), R[k + 1] * h);
-        if (s.b > s.a && s.b > window.a && s.a < window.b) shadows.push_back(s);
-    }
-    std::sort(shadows.begin(), shadows.end(), [](const Interval& x, const Interval& y) { return x.a < y.a; });
-    double reach = window.a;
-    for (const Interval& s : shadows) {
-        if (s.a > reach) return false;  // a gap of positive width
-        reach = std::max(reach, s.b);
-        if (reach >= window.b) return true;
-    }
-    return false;
-}
+// Points of a section before its pieces' ends (Band::head): its own two
+// ends, two points of the lower side and two of the upper, then the ends of
+// patch i and of patch j; about the section's midpoint.
+constexpr size_t section_head = 10;
 
 // The y at depth t of the line through p and q (a side of the shaft, whose
 // ends lie on either side of every depth between the patches).
 double y_at(double t, Vec2 p, Vec2 q) { return p.y + (t - p.x) / (q.x - p.x) * (q.y - p.y); }
 
+// Upper bound on the free length of section s of the band at every
+// direction of [c - h, c + h]: the length, among the lines that cross the
+// section, stay inside the shaft over the band's depths and meet both
+// patches, of those the pieces bucketed to it may leave open. Each point's
+// offset n(phi) . P (about the section's midpoint) is within |P| h of its
+// value at c; the lines to stop are widened by that, each piece's shadow
+// narrowed by it (what it shadows at every direction of the bin). Stops
+// once the free length exceeds `budget` (and returns what it has, >
+// budget). Anything not finite gives +infinity.
+double uncovered(const Band& band, int s, double c, double h, const size_t* items, size_t count, double budget,
+                 OpaqueBandScratch& ws) {
+    const double nx = -std::sin(c), ny = std::cos(c);
+    const Vec2* P = ws.points.data() + band.head + section_head * static_cast<size_t>(s);
+    const double* R = ws.radius.data() + band.head + section_head * static_cast<size_t>(s);
+    auto proj = [&](size_t k) { return nx * P[k].x + ny * P[k].y; };
+    auto wide = [&](size_t k) { return swept(proj(k), R[k] * h, proj(k + 1), R[k + 1] * h); };
+    // Lines across the section (points 0, 1), above the lower side at the
+    // band's outer depths (points 2, 3), below the upper side there (4, 5),
+    // meeting patch i (6, 7) and patch j (8, 9). The section's own ends are
+    // widened too: the sections tile X at the bin's centre direction only,
+    // and elsewhere in the bin a line through a boundary between two
+    // sections can fall outside both unwidened windows.
+    Interval window = wide(0);
+    for (const size_t k : {size_t{2}, size_t{3}}) window.a = std::max(window.a, proj(k) - R[k] * h);
+    for (const size_t k : {size_t{4}, size_t{5}}) window.b = std::min(window.b, proj(k) + R[k] * h);
+    for (const size_t k : {size_t{6}, size_t{8}}) {
+        const Interval patch = wide(k);
+        window = {std::max(window.a, patch.a), std::min(window.b, patch.b)};
+    }
+    if (!(window.b > window.a)) return window.b <= window.a ? 0 : not_shown;  // no line to stop, or not finite
+    // The pieces' shadows, about the section's midpoint O.
+    const Vec2 O{band.t0, band.ya + (s + 0.5) * band.w};
+    auto& shadows = ws.shadows;
+    shadows.clear();
+    const Vec2* local = ws.local.data();
+    for (size_t it = 0; it < count; ++it) {
+        const Vec2 p = local[2 * items[it]] - O, q = local[2 * items[it] + 1] - O;
+        const Interval sh = held(nx * p.x + ny * p.y, norm(p) * h, nx * q.x + ny * q.y, norm(q) * h);
+        if (sh.b > sh.a && sh.b > window.a && sh.a < window.b) shadows.push_back(sh);
+    }
+    std::sort(shadows.begin(), shadows.end(), [](const Interval& x, const Interval& y) { return x.a < y.a; });
+    // The gaps between the shadows, summed (not the window less the covered
+    // length: a covered window gives exactly 0).
+    double reach = window.a, free = 0;
+    for (const Interval& sh : shadows) {
+        if (sh.a > reach) {
+            free += sh.a - reach;
+            if (free > budget) return free;
+        }
+        reach = std::max(reach, sh.b);
+        if (reach >= window.b) return free;
+    }
+    return free + (window.b - reach);
+}
+
+// The band's free length at every direction of [c - h, c + h], summed over
+// its sections; more than `bar` (and so stopped early, the sum unfinished)
+// when it exceeds bar.
+double band_free(const Band& band, double c, double h, double bar, OpaqueBandScratch& ws) {
+    // Each piece goes to the sections its offsets at c can reach (a filter
+    // only: a piece left out of a section only leaves more free). About the
+    // band's corner (t0, ya) a point (t0, y) of X is at cos(c) (y - ya), so
+    // section s spans [s, s + 1] cos(c) w, widened by its ends' drift w h / 2;
+    // a piece's shadow at c lies between its ends' offsets, and its held
+    // shadow within that.
+    const double nx = -std::sin(c), ny = std::cos(c), span = ny * band.w, pad = 0.5 * band.w * h;
+    const Vec2* local = ws.local.data();
+    const int S = band.sections;
+    auto& first_of = ws.bucket_first;
+    auto& items = ws.bucket_items;
+    auto& range = ws.bucket_range;
+    first_of.assign(static_cast<size_t>(S) + 1, 0);
+    range.resize(band.last - band.first);
+    for (size_t r = band.first; r < band.last; ++r) {
+        const size_t q = ws.index[r];
+        const double pp = nx * (local[2 * q].x - band.t0) + ny * (local[2 * q].y - band.ya);
+        const double pq = nx * (local[2 * q + 1].x - band.t0) + ny * (local[2 * q + 1].y - band.ya);
+        const double lo = std::floor((std::min(pp, pq) - pad) / span), hi = std::floor((std::max(pp, pq) + pad) / span);
+        const int a = static_cast<int>(std::clamp(lo, 0.0, static_cast<double>(S)));
+        const int b = static_cast<int>(std::clamp(hi, -1.0, S - 1.0));
+        range[r - band.first] = {a, b};
+        for (int sct = a; sct <= b; ++sct) ++first_of[static_cast<size_t>(sct) + 1];
+    }
+    for (int sct = 0; sct < S; ++sct) first_of[static_cast<size_t>(sct) + 1] += first_of[static_cast<size_t>(sct)];
+    items.resize(first_of[static_cast<size_t>(S)]);
+    auto& fill = ws.bucket_fill;
+    fill.assign(first_of.begin(), first_of.end() - 1);
+    for (size_t r = band.first; r < band.last; ++r) {
+        const auto [a, b] = range[r - band.first];
+        for (int sct = a; sct <= b; ++sct) items[fill[static_cast<size_t>(sct)]++] = ws.index[r];
+    }
+    double sum = 0;
+    for (int sct = 0; sct < S && sum <= bar; ++sct) {
+        const size_t f = first_of[static_cast<size_t>(sct)], l = first_of[static_cast<size_t>(sct) + 1];
+        sum += uncovered(band, sct, c, h, items.data() + f, l - f, bar - sum, ws);
+    }
+    return sum;
+}
+
 }  // namespace
 
-bool band_closes_shaft(const Segment& ci, const Segment& cj, const Segment* blockers, size_t count,
-                       OpaqueBandScratch& ws) {
-    if (count == 0) return false;
+double band_bound(const Segment& ci, const Segment& cj, const Segment* blockers, size_t count,
+                  const BandOptions& options, OpaqueBandScratch& ws) {
+    const double limit = options.limit;
+    if (count == 0 || !(limit >= 0)) return not_shown;
     const shaft_detail::PairFrame frame(ci, cj);
     const double delta = frame.delta_theta;
-    if (!(delta > 0) || !std::isfinite(delta)) return false;
+    if (!(delta > 0) || !std::isfinite(delta)) return not_shown;
     // The shaft A0 A1 C0 C1 in the frame, x the depth along the pair's axis.
     const Vec2 A0 = frame.local(ci.a), A1 = frame.local(ci.b), C0 = frame.local(cj.a), C1 = frame.local(cj.b);
     const double xi = std::max(A0.x, A1.x), xj = std::min(C0.x, C1.x);
-    if (!(xj > xi) || !std::isfinite(xj - xi)) return false;  // no transversal x = t0 between them
+    if (!(xj > xi) || !std::isfinite(xj - xi)) return not_shown;  // no transversal x = t0 between them
 
     // The blockers clipped to the slab xi <= x <= xj: a line from ci to
     // cj is at those depths only between its ends on the patches (its depth
@@ -93,7 +159,7 @@ bool band_closes_shaft(const Segment& ci, const Segment& cj, const Segment* bloc
         local.push_back(lerp(P, Q, t_hi));
     }
     const size_t n = local.size() / 2;
-    if (n == 0) return false;
+    if (n == 0) return not_shown;
     {
         // Layers over the whole slab: the pieces' shadows across the axis
         // over the shaft's mean width. A band holds a share of them; with
@@ -102,7 +168,7 @@ bool band_closes_shaft(const Segment& ci, const Segment& cj, const Segment* bloc
         for (size_t q = 0; q < n; ++q) across += std::abs(local[2 * q + 1].y - local[2 * q].y);
         const auto width_at = [&](double t) { return std::abs(y_at(t, A1, C0) - y_at(t, C1, A0)); };
         const double mean_width = 0.5 * (width_at(xi) + width_at(xj));
-        if (!(across >= opaque_band_min_layers * mean_width)) return false;
+        if (!(across >= opaque_band_min_layers * mean_width)) return not_shown;
     }
     // The pieces by the depth of their midpoints: a band is a run of them
     // around its depth.
@@ -118,11 +184,11 @@ bool band_closes_shaft(const Segment& ci, const Segment& cj, const Segment* bloc
 
     ws.points.clear();
     ws.radius.clear();
-    auto& sections = ws.sections;
-    sections.clear();
-    // Band k (the middle one first) as sections [first, sections.size());
-    // returns the widest bin half-width at which its pieces drift by at
-    // most opaque_band_drift of their mean shadow (0: no piece).
+    auto& bands = ws.bands;
+    bands.clear();
+    // Band k (the middle one first); returns the widest bin half-width at
+    // which its pieces drift by at most options.drift of their mean shadow
+    // (0: no piece).
     auto build_band = [&](int k) {
         const int slot = (k + opaque_band_count / 2) % opaque_band_count;
         const double t0 = xi + (xj - xi) * (slot + 0.5) / opaque_band_count;
@@ -155,47 +221,14 @@ bool band_closes_shaft(const Segment& ci, const Segment& cj, const Segment* bloc
         const double mean_shadow = across / static_cast<double>(taken);
         const double wanted = std::ceil((yb - ya) / (opaque_band_section_shadows * mean_shadow));
         const int S = static_cast<int>(std::clamp(wanted, 1.0, static_cast<double>(opaque_band_max_sections)));
-        // A piece whose offset can reach a section's lines at some direction
-        // of the range: across the axis within the section's half-width, plus
-        // its depth from t0 times tan(delta), over cos(delta) (a wider margin
-        // only costs time).
-        const double depth = std::max(before, after);
         const double w = (yb - ya) / S;
-        const double margin = (0.5 * w + depth * std::tan(delta)) / std::cos(delta) + 0.5 * w;
-        // Which sections each piece may reach (counting sort by section).
-        auto& first_of = ws.bucket_first;
-        auto& items = ws.bucket_items;
-        first_of.assign(static_cast<size_t>(S) + 1, 0);
-        auto span = [&](size_t q) {
-            const Vec2 P = local[2 * q], Q = local[2 * q + 1];
-            const double lo = std::ceil((std::min(P.y, Q.y) - margin - ya) / w - 0.5);
-            const double hi = std::floor((std::max(P.y, Q.y) + margin - ya) / w - 0.5);
-            return std::pair<int, int>{static_cast<int>(std::clamp(lo, 0.0, S - 1.0)),
-                                       static_cast<int>(std::clamp(hi, -1.0, S - 1.0))};
-        };
-        for (size_t r = left; r < right; ++r) {
-            const auto [lo, hi] = span(index[r]);
-            for (int s = lo; s <= hi; ++s) ++first_of[static_cast<size_t>(s) + 1];
-        }
-        for (int s = 0; s < S; ++s) first_of[static_cast<size_t>(s) + 1] += first_of[static_cast<size_t>(s)];
-        items.resize(first_of[static_cast<size_t>(S)]);
-        {
-            auto& fill = ws.bucket_fill;
-            fill.assign(first_of.begin(), first_of.end() - 1);
-            for (size_t r = left; r < right; ++r) {
-                const auto [lo, hi] = span(index[r]);
-                for (int s = lo; s <= hi; ++s) items[fill[static_cast<size_t>(s)]++] = index[r];
-            }
-        }
-        double reach = 0;
+        bands.push_back({t0, ya, w, S, left, right, ws.points.size()});
         for (int s = 0; s < S; ++s) {
             const double y0 = ya + w * s, y1 = ya + w * (s + 1);
             const Vec2 O{t0, 0.5 * (y0 + y1)};
-            Section section{ws.points.size(), 0};
             auto add = [&](Vec2 p) {
                 ws.points.push_back(p - O);
                 ws.radius.push_back(norm(p - O));
-                ++section.count;
             };
             add({t0, y0});
             add({t0, y1});
@@ -205,46 +238,42 @@ bool band_closes_shaft(const Segment& ci, const Segment& cj, const Segment* bloc
             // pieces inside the shaft need not stop) are not asked for.
             for (const double t : {t0 - before, t0 + after}) add({t, low_side(t)});
             for (const double t : {t0 - before, t0 + after}) add({t, high_side(t)});
-            for (size_t it = first_of[static_cast<size_t>(s)]; it < first_of[static_cast<size_t>(s) + 1]; ++it) {
-                add(local[2 * items[it]]);
-                add(local[2 * items[it] + 1]);
-            }
-            for (size_t q = section.first; q < section.first + section.count; ++q)
-                reach = std::max(reach, ws.radius[q]);
-            sections.push_back(section);
+            for (const Vec2 end : {A0, A1, C0, C1}) add(end);
         }
-        return reach > 0 ? opaque_band_drift * mean_shadow / reach : 0.0;
+        // A piece's ends are within the band's depth of t0, and (where they
+        // matter) about a section's width of its midpoint.
+        const double reach = std::hypot(std::max(before, after), 0.5 * w + mean_shadow);
+        return reach > 0 ? options.drift * mean_shadow / reach : 0.0;
     };
 
     // The bins: at least opaque_band_initial_bins, narrow enough for the
-    // middle band. The other bands are built when a bin needs them; the
-    // first bin no band closes ends the attempt (an open shaft usually
-    // shows it within a few bins).
-    size_t band_first[opaque_band_count + 1] = {};
-    int built = 1;
+    // middle band. Each bin takes the least of the bands' free lengths (each
+    // band alone stops all but its own free lines); the other bands are
+    // built when a bin needs them.
+    // The first bin that takes the sum past the limit ends the attempt (an
+    // open shaft usually shows it within a few bins).
     const double h_band = build_band(0);
-    band_first[1] = sections.size();
-    if (!(h_band > 0)) return false;
+    if (!(h_band > 0)) return not_shown;
     const double bins_wanted = std::max<double>(opaque_band_initial_bins, std::ceil(delta / h_band));
-    if (!(bins_wanted <= opaque_band_max_bins)) return false;  // too costly (or not finite)
-    if (bins_wanted * static_cast<double>(band_first[1]) > opaque_band_max_checks) return false;
+    if (!(bins_wanted <= opaque_band_max_bins)) return not_shown;  // too costly (or not finite)
+    if (!(bins_wanted * bands[0].sections <= options.max_checks)) return not_shown;
     const int bins = static_cast<int>(bins_wanted);
     const double h = delta / bins;
+    double total = 0;  // the sum over bins of h times the bin's free length
     for (int b = 0; b < bins; ++b) {
-        const Bin bin{-delta + (2 * b + 1) * h, h};
-        bool closed = false;
-        for (int k = 0; k < opaque_band_count && !closed; ++k) {
-            if (k == built) {
-                build_band(k);
-                band_first[++built] = sections.size();
-            }
-            closed = band_first[k + 1] > band_first[k];
-            for (size_t sct = band_first[k]; sct < band_first[k + 1] && closed; ++sct)
-                closed = covers(sections[sct], bin, ws);
+        const double c = -delta + (2 * b + 1) * h;
+        const double allowance = (limit - total) / h;  // the most this bin may leave free
+        double best = not_shown;
+        for (int k = 0; k < opaque_band_count && best > 0; ++k) {
+            if (k == static_cast<int>(bands.size()) && !(build_band(k) > 0)) break;  // no piece
+            const double bar = std::min(best, allowance);
+            const double sum = band_free(bands[static_cast<size_t>(k)], c, h, bar, ws);
+            if (sum <= bar) best = sum;  // finished, and the least so far
         }
-        if (!closed) return false;
+        if (!(best <= allowance)) return not_shown;
+        total += h * best;
     }
-    return true;
+    return total;
 }
 
 }  // namespace flatrad

@@ -15,6 +15,7 @@ struct VisibilityStats {
     long subshafts = 0;         ///< shafts split in two because they held many blockers
     long bounded = 0;           ///< answered by direction bounds within the tolerance (direction_bounds.h)
     long opaque = 0;            ///< shafts shown closed by a band of pieces across them (opaque_band.h)
+    long banded = 0;            ///< answered by bands' upper bound within the tolerance (opaque_band.h)
 
     VisibilityStats& operator+=(const VisibilityStats& o) {
         queries += o.queries;
@@ -28,6 +29,7 @@ struct VisibilityStats {
         subshafts += o.subshafts;
         bounded += o.bounded;
         opaque += o.opaque;
+        banded += o.banded;
         return *this;
     }
 };

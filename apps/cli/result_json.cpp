@@ -152,6 +152,7 @@ ordered_json visibility_stats_json(const VisibilityStats& s) {
     j["subshafts"] = s.subshafts;
     j["bounded"] = s.bounded;
     j["opaque"] = s.opaque;
+    j["banded"] = s.banded;
     return j;
 }
 
