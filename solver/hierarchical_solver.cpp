@@ -49,6 +49,13 @@ constexpr int TW = directional_table_width;  // samples, then the linear part
 // refinement's decisions) a batch runs on one thread; geometry and gathers
 // (~1 us each) need 16x more.
 constexpr long parallel_min_work = 64;
+// The gather runs on both cores only above this many links: below, one
+// gather is tens of microseconds, of the order of waking the other thread
+// (2 cores, medians of 10 / 5 runs, GMRES time: the 1000-segment forest at
+// eps 5, 12 625 links, 0.0228 s in parallel against 0.0162 s serial; round
+// rooms of 10^4 / 10^5 walls, 139 313 / 560 436 links, 0.0190 / 0.192 s in
+// parallel against 0.0235 / 0.223 s serial).
+constexpr size_t gather_min_links = 32768;
 // Chain links are made in rooms holding at most this many segments that
 // may block, each checked against each chain link (chain_clear).
 constexpr long max_chain_blockers = 64;
@@ -1992,7 +1999,7 @@ void HierarchicalSolver::apply_G(const Eigen::VectorXd& x, Eigen::VectorXd& out,
     clear_scratch(m_Hn, m_J, part);
     // Gather, in parallel over receivers.
     const long R = static_cast<long>(part ? part->receivers.size() : m_receivers.size());
-#pragma omp parallel for num_threads(m_threads) schedule(dynamic, 256) if (R > 16 * parallel_min_work)
+#pragma omp parallel for num_threads(m_threads) schedule(dynamic, 256) if (R > 16 * parallel_min_work && m_links.size() > gather_min_links)
     for (long qq = 0; qq < R; ++qq) {
         const long q = part ? part->receivers[static_cast<size_t>(qq)] : qq;
         const int r = m_receivers[static_cast<size_t>(q)];
