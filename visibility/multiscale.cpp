@@ -14,7 +14,6 @@ namespace flatrad {
 
 using namespace shaft_detail;
 
-
 namespace {
 
 constexpr double infinity = std::numeric_limits<double>::infinity();
@@ -797,6 +796,7 @@ MultiscaleResult MultiscaleVisibility::form_factor_skipping(const Segment& i, co
             direction_bounds(g.ci, g.cj, pieces.data(), pieces.size(), eps * g.L_i, budget, ws.bounds);
         if (b.converged) {
             ++stats.bounded;
+            stats.events += b.evaluations;
             out.F = 0.5 * (b.lo + b.hi) / g.L_i;
             out.error_bound = 0.5 * (b.hi - b.lo) / g.L_i;
             return out;

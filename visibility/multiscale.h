@@ -16,9 +16,12 @@
 /// by adaptive Gauss-Kronrod between the critical directions of the exact
 /// part, to 1e-3 eps; its error estimate is added to the bound.
 ///
-/// Before either, where the caller enables it (set_min_pieces_to_bound; the
-/// hierarchical solver does, from 32 pieces), a shaft crowded with blocker
-/// pieces is tried with guaranteed bounds by direction bins
+/// Before either, where the caller enables them, bands of pieces across a
+/// crowded shaft may show it closed or bound it within the tolerance
+/// (set_min_pieces_to_prove_closed, opaque_band.h); then, where enabled
+/// (set_min_pieces_to_bound; the hierarchical solver does both, from 32
+/// pieces), a shaft crowded with blocker pieces is tried with guaranteed
+/// bounds by direction bins
 /// (direction_bounds.h): the pieces' shadows widened and narrowed by how
 /// far they can move within a bin, bins halved worst first. If the bounds
 /// close to within 2 eps within a budget of bins (2 per piece), their
@@ -154,11 +157,12 @@ public:
     /// replace (the cluster approximation is left to shafts of 512 pieces or
     /// more), they make a 1000-segment forest 14x faster at 1% error.
     void set_min_pieces_to_bound(size_t n) { m_min_pieces_to_bound = n; }
-    /// Try to prove a shaft of at least `n` blocker pieces closed by a band
-    /// of its pieces across it (opaque_band.h) before anything else: an
-    /// exact 0 when it succeeds (stats.opaque), at any eps. Off by default
-    /// (SIZE_MAX): a failed attempt is wasted, and pays only where many
-    /// crowded shafts are closed (dense forests).
+    /// Try bands of pieces across a shaft of at least `n` blocker pieces
+    /// (opaque_band.h) before anything else: a proof that it is closed (an
+    /// exact 0, stats.opaque, at any eps) or, with eps > 0, an upper bound U
+    /// within 2 eps, answered as U / 2 with bound U / 2 (stats.banded).
+    /// Off by default (SIZE_MAX): a failed attempt is wasted, and pays only
+    /// where many crowded shafts are nearly or wholly closed (dense forests).
     void set_min_pieces_to_prove_closed(size_t n) { m_min_pieces_to_prove_closed = n; }
 
 private:
