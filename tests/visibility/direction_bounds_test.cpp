@@ -9,9 +9,11 @@
 
 #include <cmath>
 #include <random>
+#include <tuple>
 
 #include "engine/formfactor.h"
 #include "visibility/exact_visibility.h"
+#include "support/facing_pairs.h"
 #include "visibility/shaft.h"
 
 using namespace flatrad;
@@ -32,16 +34,7 @@ struct Case {
 Case random_case(std::mt19937_64& rng, int n, double piece_length) {
     std::uniform_real_distribution<double> u(0, 1);
     Case c;
-    for (;;) {
-        const double gap = 0.3 + 3 * u(rng);
-        const Segment i{{u(rng) * 0.5, 0}, {1 + u(rng), 0}};
-        const Segment j{{0.7 + 2 * u(rng), gap + 0.5 * (u(rng) - 0.5)}, {2 * u(rng) - 0.5, gap + 0.5 * (u(rng) - 0.5)}};
-        const auto clipped = clip_to_lit_halfplanes(i, j);
-        if (!clipped) continue;
-        c.ci = clipped->first;
-        c.cj = clipped->second;
-        break;
-    }
+    std::tie(c.ci, c.cj) = test::random_facing_pair(rng);
     const shaft_detail::Shaft shaft(c.ci, c.cj);
     const Box& b = shaft.box;
     int tries = 0;

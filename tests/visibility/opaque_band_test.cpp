@@ -11,9 +11,11 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <tuple>
 
 #include "engine/formfactor.h"
 #include "visibility/exact_visibility.h"
+#include "support/facing_pairs.h"
 #include "visibility/shaft.h"
 
 using namespace flatrad;
@@ -92,16 +94,7 @@ struct RandomShaft {
 RandomShaft random_shaft(int n, std::mt19937_64& rng, bool lane = false) {
     std::uniform_real_distribution<double> u(0, 1);
     RandomShaft out;
-    for (;;) {
-        const double gap = 0.3 + 3 * u(rng);
-        const Segment i{{u(rng) * 0.5, 0}, {1 + u(rng), 0}};
-        const Segment j{{0.7 + 2 * u(rng), gap + 0.5 * (u(rng) - 0.5)}, {2 * u(rng) - 0.5, gap + 0.5 * (u(rng) - 0.5)}};
-        const auto clipped = clip_to_lit_halfplanes(i, j);
-        if (!clipped) continue;
-        out.ci = clipped->first;
-        out.cj = clipped->second;
-        break;
-    }
+    std::tie(out.ci, out.cj) = test::random_facing_pair(rng);
     const shaft_detail::Shaft shaft(out.ci, out.cj);
     const Box& box = shaft.box;
     const double lane_x = lane ? 0.5 + 0.5 * u(rng) : 0;
