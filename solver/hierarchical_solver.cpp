@@ -321,14 +321,13 @@ public:
           m_obox(oriented_boxes(m_hierarchy)) {
         m_threads = o.threads > 0 ? o.threads : omp_get_max_threads();
         m_vis_eps = o.vis_eps >= 0 ? o.vis_eps : o.eps / 10;
-        m_vis.set_min_pieces_to_approximate(min_pieces_to_approximate);
-        m_vis.set_min_pieces_to_bound(min_pieces_to_bound);
-        m_vis.set_min_pieces_to_prove_closed(min_pieces_to_prove_closed);
-
         // Walls on the scene's hull block nothing (engine/convex_scene.h):
         // visibility skips them; with no blocker at all it is never asked.
         const std::vector<char> blockers = possible_blockers(scene);
         m_hierarchy.set_blockers(blockers);
+        m_vis.set_min_pieces_to_approximate(min_pieces_to_approximate);
+        m_vis.set_min_pieces_to_bound(min_pieces_to_bound);
+        m_vis.set_min_pieces_to_prove_closed(min_pieces_to_prove_closed);  // (after set_blockers: see there)
         m_unblockable = std::find(blockers.begin(), blockers.end(), 1) == blockers.end();
         // A few things inside a room (a lamp, a pillar): chain links check
         // them one by one (chain_clear); with more, none is made.

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 
 #include "engine/error.h"
 #include "engine/formfactor.h"
@@ -39,6 +40,16 @@ constexpr double quadrature_share = 1e-3;
 // 6.0e-3 / 4.0e-3 / 1.8e-3: at 1% error, 12x faster than none.
 constexpr long bounds_min_budget = 16;
 constexpr double bounds_budget_per_piece = 2;
+// A long shaft (0 in form_factor_skipping): at least long_shaft_layers
+// layers of shadow between the patches by the scene's density, where the
+// slabs around the three bands' depths, band_slab_layers each (a band
+// takes opaque_band_layers), are walked first. On the forests of
+// `scripts/make-scene N --density 30` (2 cores): at 10^5 segments and eps
+// 10, 102 s before, 65 s with them (the same links, 1.04 million; 225 000
+// queries settled by the slabs alone); at 10^4 and 10^3 the same times
+// and links (few shafts that long); from 28 layers on, no different.
+constexpr double long_shaft_layers = 36;
+constexpr double band_slab_layers = 8;
 // Depth cap of the adaptive Gauss-Kronrod bisection on one arc.
 constexpr int max_quadrature_depth = 30;
 
@@ -619,6 +630,21 @@ MultiscaleVisibility::MultiscaleVisibility(const Hierarchy& hierarchy, const Clu
         m_position[static_cast<size_t>(hierarchy.order()[k])] = static_cast<int32_t>(k);
 }
 
+void MultiscaleVisibility::set_min_pieces_to_prove_closed(size_t n) {
+    m_min_pieces_to_prove_closed = n;
+    m_layers_per_depth = 0;
+    const int root = m_hierarchy->root();
+    if (root < 0) return;
+    double length = 0;
+    for (size_t k = 0; k < m_hierarchy->segments().size(); ++k)
+        if (m_hierarchy->can_block(static_cast<int>(k))) length += m_hierarchy->segments()[k].length();
+    const Vec2 e = m_hierarchy->node(root).box.extent();
+    const double area = e.x * e.y;
+    // A segment of length L, at a random angle, shadows 2 L / pi across a
+    // line of sight on average.
+    if (area > 0 && std::isfinite(length)) m_layers_per_depth = 2 / std::numbers::pi * length / area;
+}
+
 ClusterCriteria MultiscaleVisibility::criteria(int node, const Segment& i, const Segment& j) const {
     return criteria_for(*m_tables, node, pair_geometry(i, j));
 }
@@ -730,6 +756,103 @@ MultiscaleResult MultiscaleVisibility::form_factor_skipping(const Segment& i, co
         return (pos >= skip_a.first && pos < skip_a.first + skip_a.count) ||
                (pos >= skip_b.first && pos < skip_b.first + skip_b.count);
     };
+    // 0. A long shaft: bands need only the pieces near their depths
+    //    (opaque_band.h). Where the scene's density puts long_shaft_layers
+    //    layers of shadow between the patches, the slabs around the three
+    //    bands' depths (band_slab_layers each) are walked first, alone; if
+    //    the bands settle the query, the rest of the shaft is never walked.
+    //    Otherwise the walk below starts over.
+    if (m_layers_per_depth > 0 && m_min_pieces_to_prove_closed != std::numeric_limits<size_t>::max()) {
+        const PairFrame f(g.ci, g.cj);
+        const double xi = std::max(dot(g.ci.a - f.origin, f.u), dot(g.ci.b - f.origin, f.u));
+        const double xj = std::min(dot(g.cj.a - f.origin, f.u), dot(g.cj.b - f.origin, f.u));
+        const double depth = xj - xi;
+        if (std::isfinite(depth) && depth * m_layers_per_depth >= long_shaft_layers) {
+            const double half = 0.5 * band_slab_layers / m_layers_per_depth;
+            double slab_lo[opaque_band_count], slab_hi[opaque_band_count];
+            for (int k = 0; k < opaque_band_count; ++k) {
+                const double t0 = xi + depth * (k + 0.5) / opaque_band_count;  // as band_bound places them
+                slab_lo[k] = t0 - half;
+                slab_hi[k] = t0 + half;
+            }
+            auto in_slabs = [&](double lo, double hi) {
+                for (int k = 0; k < opaque_band_count; ++k)
+                    if (hi >= slab_lo[k] && lo <= slab_hi[k]) return true;
+                return false;
+            };
+            auto& found = ws.band.blockers;  // whole segments
+            found.clear();
+            auto& clipped = ws.blockers;  // (scratch)
+            bool closed = false;
+            long visited = 0;
+            auto& stack = ws.stack;
+            stack.clear();
+            if (m_hierarchy->root() >= 0) stack.push_back(m_hierarchy->root());
+            while (!stack.empty() && !closed) {
+                const ClusterNode& n = m_hierarchy->node(stack.back());
+                stack.pop_back();
+                if (n.blockers == 0) continue;
+                ++visited;
+                if (!shaft.overlaps(n.box)) continue;
+                {
+                    // The box's depths along the axis: its centre's, +- its half extent seen along it.
+                    const double c = dot(n.box.center() - f.origin, f.u);
+                    const Vec2 e = n.box.extent();
+                    const double r = 0.5 * (std::abs(e.x * f.u.x) + std::abs(e.y * f.u.y));
+                    if (!in_slabs(c - r, c + r)) continue;
+                }
+                if (!n.leaf()) {
+                    stack.push_back(n.child[1]);
+                    stack.push_back(n.child[0]);
+                    continue;
+                }
+                for (int q = n.first; q < n.first + n.count && !closed; ++q) {
+                    if (skipped(q)) continue;
+                    const int sg = m_hierarchy->order()[static_cast<size_t>(q)];
+                    if (!m_hierarchy->can_block(sg)) continue;
+                    const Segment& b = m_hierarchy->segments()[static_cast<size_t>(sg)];
+                    const double da = dot(b.a - f.origin, f.u), db = dot(b.b - f.origin, f.u);
+                    if (!in_slabs(std::min(da, db), std::max(da, db))) continue;
+                    // The whole segment goes to the bands (they clip it in
+                    // depth only): its shadow must reach past the shaft's
+                    // sides, as the lines they check may, by their drift.
+                    clipped.clear();
+                    closed = add_blocker(shaft, b, size, clipped);
+                    if (!clipped.empty()) found.push_back(b);
+                }
+            }
+            out.clusters_visited += visited;
+            if (closed) {
+                // One piece from side to side: closed, whatever else is there.
+                stats.clusters_visited += out.clusters_visited;
+                ++stats.queries;
+                ++stats.separated;
+                return out;
+            }
+            if (found.size() >= m_min_pieces_to_prove_closed) {
+                BandOptions band;  // eps = 0: the proof of closure alone
+                if (eps > 0) {
+                    band.limit = 2 * eps * g.L_i;
+                    band.drift = band_bound_drift;
+                    band.max_checks = band_bound_max_checks;
+                }
+                const double upper = band_bound(g.ci, g.cj, found.data(), found.size(), band, ws.band);
+                if (upper <= band.limit) {
+                    stats.clusters_visited += out.clusters_visited;
+                    ++stats.queries;
+                    ++stats.slabs;
+                    if (upper == 0) {
+                        ++stats.opaque;
+                        return out;
+                    }
+                    ++stats.banded;
+                    out.F = 0.5 * upper / g.L_i;
+                    out.error_bound = 0.5 * upper / g.L_i;
+                    return out;
+                }
+            }
+        }
+    }
     // 1a. Every blocker piece in the shaft, with its position in the
     //     hierarchy's order (a left-first walk visits positions in order).
     std::vector<Segment> pieces;

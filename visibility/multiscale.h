@@ -18,7 +18,9 @@
 ///
 /// Before either, where the caller enables them, bands of pieces across a
 /// crowded shaft may show it closed or bound it within the tolerance
-/// (set_min_pieces_to_prove_closed, opaque_band.h); then, where enabled
+/// (set_min_pieces_to_prove_closed, opaque_band.h; in a long shaft only the
+/// slabs around the bands' depths are walked for that, the rest only if
+/// they do not settle the query); then, where enabled
 /// (set_min_pieces_to_bound; the hierarchical solver does both, from 32
 /// pieces), a shaft crowded with blocker pieces is tried with guaranteed
 /// bounds by direction bins
@@ -163,7 +165,11 @@ public:
     /// within 2 eps, answered as U / 2 with bound U / 2 (stats.banded).
     /// Off by default (SIZE_MAX): a failed attempt is wasted, and pays only
     /// where many crowded shafts are nearly or wholly closed (dense forests).
-    void set_min_pieces_to_prove_closed(size_t n) { m_min_pieces_to_prove_closed = n; }
+    /// A long shaft (long_shaft_layers of shadow between the patches by
+    /// the scene's density) is first walked only in the slabs around the
+    /// bands' depths. The density is taken from the hierarchy's blockers
+    /// when this is called: call it after Hierarchy::set_blockers.
+    void set_min_pieces_to_prove_closed(size_t n);
 
 private:
     std::optional<TransmittanceResult> transmittance_between(const Segment& sa, const Segment& sb, int skip_a,
@@ -183,6 +189,7 @@ private:
     size_t m_min_pieces = 0;
     size_t m_min_pieces_to_bound = std::numeric_limits<size_t>::max();
     size_t m_min_pieces_to_prove_closed = std::numeric_limits<size_t>::max();
+    double m_layers_per_depth = 0;  // the scene's layers of shadow per unit of depth (0: unknown)
 };
 
 }  // namespace flatrad

@@ -16,6 +16,7 @@ struct VisibilityStats {
     long bounded = 0;           ///< answered by direction bounds within the tolerance (direction_bounds.h)
     long opaque = 0;            ///< shafts shown closed by a band of pieces across them (opaque_band.h)
     long banded = 0;            ///< answered by bands' upper bound within the tolerance (opaque_band.h)
+    long slabs = 0;             ///< of opaque and banded: settled by a long shaft's slabs alone (multiscale.h)
 
     VisibilityStats& operator+=(const VisibilityStats& o) {
         queries += o.queries;
@@ -30,6 +31,7 @@ struct VisibilityStats {
         bounded += o.bounded;
         opaque += o.opaque;
         banded += o.banded;
+        slabs += o.slabs;
         return *this;
     }
 };

@@ -153,6 +153,7 @@ ordered_json visibility_stats_json(const VisibilityStats& s) {
     j["bounded"] = s.bounded;
     j["opaque"] = s.opaque;
     j["banded"] = s.banded;
+    j["slabs"] = s.slabs;
     return j;
 }
 

@@ -185,6 +185,59 @@ TEST_CASE("multiscale: through crowded forests, band answers are within their bo
     CHECK(opaque >= 5);
 }
 
+TEST_CASE("multiscale: a long shaft's bands settle it from their slabs alone, within the bound") {
+    // Patches 30 apart and a blind between them: rows 0.4 apart, sticks
+    // 0.3 long with gaps of 0.1 and, alternately, 0.4 long centred on those
+    // gaps (as in opaque_band_test.cpp). Lines from i to j turn by less
+    // than 1/30, so each pair of rows stops them all: closed, exactly. The
+    // scene's density puts ~43 layers of shadow between the patches, past
+    // the 36 at which only the slabs around the bands' depths are walked
+    // first. With a channel cut through every row (the long sticks above
+    // one gap removed) the shaft is open; the answer must then be within
+    // its bound of exact.
+    constexpr double D = 30;
+    auto blind = [&](bool channel) {
+        test::Cloud c;
+        c.i = {{0, 0}, {1, 0}};
+        c.j = {{1, D}, {0, D}};
+        c.segments = {c.i, c.j};
+        int row = 0;
+        for (double y = 0.4; y < D - 0.2; y += 0.4, ++row) {
+            const bool a = row % 2 == 0;
+            for (double x = a ? -0.5 : -0.35; x < 1.6; x += 0.4) {
+                if (!a && channel && std::abs(x - 0.45) < 0.01) continue;  // over A's gap [0.6, 0.7]
+                c.segments.push_back({{x, y}, {x + (a ? 0.3 : 0.4), y}});
+            }
+        }
+        return c;
+    };
+    for (const bool channel : {false, true}) {
+        CAPTURE(channel);
+        const test::Cloud c = blind(channel);
+        test::CloudVisibility vis(c);
+        vis.multiscale.set_min_pieces_to_bound(32);
+        vis.multiscale.set_min_pieces_to_prove_closed(32);
+        ExactWorkspace ws;
+        VisibilityStats st, ex_st;
+        const double exact = vis.exact.form_factor(c.i, c.j, 0, 1, ws, ex_st);
+        const double unocc = form_factor_unoccluded(c.i, c.j);
+        if (channel)
+            REQUIRE(exact > 1e-3 * unocc);
+        else
+            REQUIRE(exact <= rounding_floor * unocc);
+        for (const double eps : {0.0, 1e-3 * unocc, 0.1 * unocc}) {
+            CAPTURE(eps);
+            const long slabs_before = st.slabs;
+            const MultiscaleResult r = vis.multiscale.form_factor(c.i, c.j, 0, 1, eps, GammaRule::Bound, ws, st);
+            CHECK(std::abs(r.F - exact) <= r.error_bound + rounding_floor * unocc);
+            if (!channel) {
+                CHECK(r.F == 0);
+                CHECK(st.slabs == slabs_before + 1);  // settled by the slabs alone
+            }
+        }
+    }
+}
+
 TEST_CASE("multiscale: transmittance between clusters is in [0, 1] and within its bound of eps = 0") {
     std::mt19937_64 rng(5);
     test::Cloud c = test::make_cloud(rng);
