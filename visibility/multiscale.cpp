@@ -756,12 +756,67 @@ MultiscaleResult MultiscaleVisibility::form_factor_skipping(const Segment& i, co
         return (pos >= skip_a.first && pos < skip_a.first + skip_a.count) ||
                (pos >= skip_b.first && pos < skip_b.first + skip_b.count);
     };
-    // 0. A long shaft: bands need only the pieces near their depths
-    //    (opaque_band.h). Where the scene's density puts long_shaft_layers
-    //    layers of shadow between the patches, the slabs around the three
-    //    bands' depths (band_slab_layers each) are walked first, alone; if
-    //    the bands settle the query, the rest of the shaft is never walked.
-    //    Otherwise the walk below starts over.
+    // The walk through the shaft: hands every blocking segment (not
+    // skipped) of each leaf whose box overlaps the shaft and passes box_ok
+    // to take(position, segment), which says whether that closes the shaft
+    // (the walk then stops: returns true).
+    auto walk = [&](auto&& box_ok, auto&& take) {
+        bool closed = false;
+        auto& stack = ws.stack;
+        stack.clear();
+        if (m_hierarchy->root() >= 0) stack.push_back(m_hierarchy->root());
+        while (!stack.empty() && !closed) {
+            const ClusterNode& n = m_hierarchy->node(stack.back());
+            stack.pop_back();
+            if (n.blockers == 0) continue;  // nothing below can block (Hierarchy::set_blockers)
+            ++out.clusters_visited;
+            if (!shaft.overlaps(n.box) || !box_ok(n.box)) continue;
+            if (!n.leaf()) {
+                stack.push_back(n.child[1]);
+                stack.push_back(n.child[0]);
+                continue;
+            }
+            for (int q = n.first; q < n.first + n.count && !closed; ++q) {
+                if (skipped(q)) continue;
+                const int s = m_hierarchy->order()[static_cast<size_t>(q)];
+                if (!m_hierarchy->can_block(s)) continue;
+                closed = take(q, m_hierarchy->segments()[static_cast<size_t>(s)]);
+            }
+        }
+        return closed;
+    };
+    // Bands of whole segments across the shaft (opaque_band.h): shown
+    // closed (exactly 0) or, with a tolerance, its exchange bounded within
+    // it, for a few small sorts; the bound's midpoint is the answer, as for
+    // the direction bounds below. True when that settles the query (`out`
+    // holds the answer).
+    auto settled_by_bands = [&](const std::vector<Segment>& whole) {
+        BandOptions band;  // eps = 0: the proof of closure alone
+        if (eps > 0) {
+            band.limit = 2 * eps * g.L_i;
+            band.drift = band_bound_drift;
+            band.max_checks = band_bound_max_checks;
+        }
+        const double upper = band_bound(g.ci, g.cj, whole.data(), whole.size(), band, ws.band);
+        if (upper == 0) {
+            ++stats.opaque;
+            return true;
+        }
+        if (upper <= band.limit) {
+            ++stats.banded;
+            out.F = 0.5 * upper / g.L_i;
+            out.error_bound = 0.5 * upper / g.L_i;
+            return true;
+        }
+        return false;
+    };
+
+    // 0. A long shaft: bands need only the pieces near their depths. Where
+    //    the scene's density puts long_shaft_layers layers of shadow between
+    //    the patches, the slabs around the three bands' depths
+    //    (band_slab_layers each) are walked first, alone; if their bands
+    //    settle the query, the rest of the shaft is never walked. Otherwise
+    //    the walk below starts over.
     if (m_layers_per_depth > 0 && m_min_pieces_to_prove_closed != std::numeric_limits<size_t>::max()) {
         const PairFrame f(g.ci, g.cj);
         const double xi = std::max(dot(g.ci.a - f.origin, f.u), dot(g.ci.b - f.origin, f.u));
@@ -780,135 +835,57 @@ MultiscaleResult MultiscaleVisibility::form_factor_skipping(const Segment& i, co
                     if (hi >= slab_lo[k] && lo <= slab_hi[k]) return true;
                 return false;
             };
+            // A box's depths along the axis: its centre's, +- its half
+            // extent seen along it.
+            auto box_in_slabs = [&](const Box& b) {
+                const double c = dot(b.center() - f.origin, f.u);
+                const Vec2 e = b.extent();
+                const double r = 0.5 * (std::abs(e.x * f.u.x) + std::abs(e.y * f.u.y));
+                return in_slabs(c - r, c + r);
+            };
             auto& found = ws.band.blockers;  // whole segments
+            auto& clipped = ws.blockers;     // (scratch)
             found.clear();
-            auto& clipped = ws.blockers;  // (scratch)
-            bool closed = false;
-            long visited = 0;
-            auto& stack = ws.stack;
-            stack.clear();
-            if (m_hierarchy->root() >= 0) stack.push_back(m_hierarchy->root());
-            while (!stack.empty() && !closed) {
-                const ClusterNode& n = m_hierarchy->node(stack.back());
-                stack.pop_back();
-                if (n.blockers == 0) continue;
-                ++visited;
-                if (!shaft.overlaps(n.box)) continue;
-                {
-                    // The box's depths along the axis: its centre's, +- its half extent seen along it.
-                    const double c = dot(n.box.center() - f.origin, f.u);
-                    const Vec2 e = n.box.extent();
-                    const double r = 0.5 * (std::abs(e.x * f.u.x) + std::abs(e.y * f.u.y));
-                    if (!in_slabs(c - r, c + r)) continue;
-                }
-                if (!n.leaf()) {
-                    stack.push_back(n.child[1]);
-                    stack.push_back(n.child[0]);
-                    continue;
-                }
-                for (int q = n.first; q < n.first + n.count && !closed; ++q) {
-                    if (skipped(q)) continue;
-                    const int sg = m_hierarchy->order()[static_cast<size_t>(q)];
-                    if (!m_hierarchy->can_block(sg)) continue;
-                    const Segment& b = m_hierarchy->segments()[static_cast<size_t>(sg)];
-                    const double da = dot(b.a - f.origin, f.u), db = dot(b.b - f.origin, f.u);
-                    if (!in_slabs(std::min(da, db), std::max(da, db))) continue;
-                    // The whole segment goes to the bands (they clip it in
-                    // depth only): its shadow must reach past the shaft's
-                    // sides, as the lines they check may, by their drift.
-                    clipped.clear();
-                    closed = add_blocker(shaft, b, size, clipped);
-                    if (!clipped.empty()) found.push_back(b);
-                }
-            }
-            out.clusters_visited += visited;
-            if (closed) {
-                // One piece from side to side: closed, whatever else is there.
+            const bool closed = walk(box_in_slabs, [&](int, const Segment& b) {
+                const double da = dot(b.a - f.origin, f.u), db = dot(b.b - f.origin, f.u);
+                if (!in_slabs(std::min(da, db), std::max(da, db))) return false;
+                // The whole segment goes to the bands (they clip it in depth
+                // only): its shadow must reach past the shaft's sides, as the
+                // lines they check may, by their drift.
+                clipped.clear();
+                const bool alone = add_blocker(shaft, b, size, clipped);
+                if (!clipped.empty()) found.push_back(b);
+                return alone;
+            });
+            if (closed || (found.size() >= m_min_pieces_to_prove_closed && settled_by_bands(found))) {
                 stats.clusters_visited += out.clusters_visited;
                 ++stats.queries;
-                ++stats.separated;
+                ++stats.slabs;
+                if (closed) ++stats.separated;  // one piece from side to side: 0
                 return out;
-            }
-            if (found.size() >= m_min_pieces_to_prove_closed) {
-                BandOptions band;  // eps = 0: the proof of closure alone
-                if (eps > 0) {
-                    band.limit = 2 * eps * g.L_i;
-                    band.drift = band_bound_drift;
-                    band.max_checks = band_bound_max_checks;
-                }
-                const double upper = band_bound(g.ci, g.cj, found.data(), found.size(), band, ws.band);
-                if (upper <= band.limit) {
-                    stats.clusters_visited += out.clusters_visited;
-                    ++stats.queries;
-                    ++stats.slabs;
-                    if (upper == 0) {
-                        ++stats.opaque;
-                        return out;
-                    }
-                    ++stats.banded;
-                    out.F = 0.5 * upper / g.L_i;
-                    out.error_bound = 0.5 * upper / g.L_i;
-                    return out;
-                }
             }
         }
     }
+
     // 1a. Every blocker piece in the shaft, with its position in the
     //     hierarchy's order (a left-first walk visits positions in order).
     std::vector<Segment> pieces;
     std::vector<int32_t> piece_pos;
-    bool separated = false;
-    auto& stack = ws.stack;
-    stack.clear();
-    if (m_hierarchy->root() >= 0) stack.push_back(m_hierarchy->root());
-    while (!stack.empty() && !separated) {
-        const ClusterNode& n = m_hierarchy->node(stack.back());
-        stack.pop_back();
-        if (n.blockers == 0) continue;  // nothing below can block (Hierarchy::set_blockers)
-        ++out.clusters_visited;
-        if (!shaft.overlaps(n.box)) continue;
-        if (!n.leaf()) {
-            stack.push_back(n.child[1]);
-            stack.push_back(n.child[0]);
-            continue;
-        }
-        for (int q = n.first; q < n.first + n.count && !separated; ++q) {
-            if (skipped(q)) continue;
-            const int s = m_hierarchy->order()[static_cast<size_t>(q)];
-            if (!m_hierarchy->can_block(s)) continue;
-            const size_t before = pieces.size();
-            separated = add_blocker(shaft, m_hierarchy->segments()[static_cast<size_t>(s)], size, pieces);
-            if (pieces.size() > before) piece_pos.push_back(q);
-        }
-    }
+    const bool separated = walk([](const Box&) { return true; }, [&](int q, const Segment& b) {
+        const size_t before = pieces.size();
+        const bool alone = add_blocker(shaft, b, size, pieces);
+        if (pieces.size() > before) piece_pos.push_back(q);
+        return alone;
+    });
     stats.clusters_visited += out.clusters_visited;
     ++stats.queries;
-    // 1b. A crowded shaft: bands of its pieces across it (opaque_band.h)
-    //     may show it closed (exactly 0) or, with a tolerance, bound its
-    //     exchange within it, for a few small sorts. The bound's midpoint is
-    //     the answer, as for the direction bounds below.
+    // 1b. A crowded shaft: bands first.
     if (!separated && pieces.size() >= m_min_pieces_to_prove_closed) {
         auto& whole = ws.band.blockers;  // the pieces' segments, unclipped
         whole.clear();
         for (const int32_t q : piece_pos)
             whole.push_back(m_hierarchy->segments()[static_cast<size_t>(m_hierarchy->order()[static_cast<size_t>(q)])]);
-        BandOptions band;  // eps = 0: the proof of closure alone
-        if (eps > 0) {
-            band.limit = 2 * eps * g.L_i;
-            band.drift = band_bound_drift;
-            band.max_checks = band_bound_max_checks;
-        }
-        const double upper = band_bound(g.ci, g.cj, whole.data(), whole.size(), band, ws.band);
-        if (upper == 0) {
-            ++stats.opaque;
-            return out;
-        }
-        if (upper <= band.limit) {
-            ++stats.banded;
-            out.F = 0.5 * upper / g.L_i;
-            out.error_bound = 0.5 * upper / g.L_i;
-            return out;
-        }
+        if (settled_by_bands(whole)) return out;
     }
     //     A crowded shaft, a loose tolerance: bounds by direction bins
     //     (direction_bounds.h) may meet it for much less than the exact
@@ -934,6 +911,8 @@ MultiscaleResult MultiscaleVisibility::form_factor_skipping(const Segment& i, co
         //     whose criterion is below eps; the pieces of the rest are exact.
         if (pieces.size() < m_min_pieces) eps = 0;  // cheaper exact (set_min_pieces_to_approximate)
         const Interactions inter(g, pieces, piece_pos, eps > 0 && rule == GammaRule::Bound && !pieces.empty());
+        auto& stack = ws.stack;
+        stack.clear();
         stack.push_back(m_hierarchy->root());
         while (!stack.empty()) {
             const int k = stack.back();
