@@ -818,9 +818,9 @@ MultiscaleResult MultiscaleVisibility::form_factor_skipping(const Segment& i, co
     //    settle the query, the rest of the shaft is never walked. Otherwise
     //    the walk below starts over.
     if (m_layers_per_depth > 0 && m_min_pieces_to_prove_closed != std::numeric_limits<size_t>::max()) {
-        const PairFrame f(g.ci, g.cj);
-        const double xi = std::max(dot(g.ci.a - f.origin, f.u), dot(g.ci.b - f.origin, f.u));
-        const double xj = std::min(dot(g.cj.a - f.origin, f.u), dot(g.cj.b - f.origin, f.u));
+        auto at_depth = [&](Vec2 p) { return dot(p - g.origin, g.u); };  // the pair's frame (PairFrame)
+        const double xi = std::max(at_depth(g.ci.a), at_depth(g.ci.b));
+        const double xj = std::min(at_depth(g.cj.a), at_depth(g.cj.b));
         const double depth = xj - xi;
         if (std::isfinite(depth) && depth * m_layers_per_depth >= long_shaft_layers) {
             const double half = 0.5 * band_slab_layers / m_layers_per_depth;
@@ -838,16 +838,16 @@ MultiscaleResult MultiscaleVisibility::form_factor_skipping(const Segment& i, co
             // A box's depths along the axis: its centre's, +- its half
             // extent seen along it.
             auto box_in_slabs = [&](const Box& b) {
-                const double c = dot(b.center() - f.origin, f.u);
+                const double c = at_depth(b.center());
                 const Vec2 e = b.extent();
-                const double r = 0.5 * (std::abs(e.x * f.u.x) + std::abs(e.y * f.u.y));
+                const double r = 0.5 * (std::abs(e.x * g.u.x) + std::abs(e.y * g.u.y));
                 return in_slabs(c - r, c + r);
             };
             auto& found = ws.band.blockers;  // whole segments
             auto& clipped = ws.blockers;     // (scratch)
             found.clear();
             const bool closed = walk(box_in_slabs, [&](int, const Segment& b) {
-                const double da = dot(b.a - f.origin, f.u), db = dot(b.b - f.origin, f.u);
+                const double da = at_depth(b.a), db = at_depth(b.b);
                 if (!in_slabs(std::min(da, db), std::max(da, db))) return false;
                 // The whole segment goes to the bands (they clip it in depth
                 // only): its shadow must reach past the shaft's sides, as the
