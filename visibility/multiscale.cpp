@@ -871,22 +871,21 @@ MultiscaleResult MultiscaleVisibility::form_factor_skipping(const Segment& i, co
     //     hierarchy's order (a left-first walk visits positions in order).
     std::vector<Segment> pieces;
     std::vector<int32_t> piece_pos;
+    auto& whole = ws.band.blockers;  // the pieces' segments, unclipped (for the bands)
+    whole.clear();
     const bool separated = walk([](const Box&) { return true; }, [&](int q, const Segment& b) {
         const size_t before = pieces.size();
         const bool alone = add_blocker(shaft, b, size, pieces);
-        if (pieces.size() > before) piece_pos.push_back(q);
+        if (pieces.size() > before) {
+            piece_pos.push_back(q);
+            whole.push_back(b);
+        }
         return alone;
     });
     stats.clusters_visited += out.clusters_visited;
     ++stats.queries;
     // 1b. A crowded shaft: bands first.
-    if (!separated && pieces.size() >= m_min_pieces_to_prove_closed) {
-        auto& whole = ws.band.blockers;  // the pieces' segments, unclipped
-        whole.clear();
-        for (const int32_t q : piece_pos)
-            whole.push_back(m_hierarchy->segments()[static_cast<size_t>(m_hierarchy->order()[static_cast<size_t>(q)])]);
-        if (settled_by_bands(whole)) return out;
-    }
+    if (!separated && pieces.size() >= m_min_pieces_to_prove_closed && settled_by_bands(whole)) return out;
     //     A crowded shaft, a loose tolerance: bounds by direction bins
     //     (direction_bounds.h) may meet it for much less than the exact
     //     integral or the mixed one; they are tried with a budget.
