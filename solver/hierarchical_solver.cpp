@@ -84,7 +84,11 @@ constexpr size_t min_pieces_to_bound = 32;
 // forest at eps 1 absorbed 12% more than it emitted, now 0.2%, in the same
 // time (10.9 s against 11.1 s) with 20% fewer links; at eps 0.1 18% faster
 // (the 1000-segment forest: 1.4% more instructions, relative L2 8.94e-3
-// -> 8.77e-3 at eps 4; tenth session's figures in the README).
+// -> 8.77e-3 at eps 4; tenth session's figures in the README). Since the
+// eleventh session the bands also bound open shafts within the tolerance,
+// and a long shaft is walked first only where its bands are (multiscale.h):
+// the 10^4 forest 11.2 -> 8.8 s at eps 1, the 10^5 forest 102 -> 65 s at
+// eps 10 (README).
 constexpr size_t min_pieces_to_prove_closed = 32;
 
 // GMRES stops at ||E - (I - rho G) B|| <= 1e-12 ||E||: the operator is
