@@ -170,6 +170,11 @@ public:
     /// bands' depths. The density is taken from the hierarchy's blockers
     /// when this is called: call it after Hierarchy::set_blockers.
     void set_min_pieces_to_prove_closed(size_t n);
+    /// The scene's mean layers of shadow per unit of depth (2 / pi times
+    /// the blockers' length over the root box's area: a segment of length L
+    /// at a random angle shadows 2 L / pi of a line on average), set by
+    /// set_min_pieces_to_prove_closed; 0 before, or with nothing to block.
+    double layers_per_depth() const { return m_layers_per_depth; }
 
 private:
     std::optional<TransmittanceResult> transmittance_between(const Segment& sa, const Segment& sb, int skip_a,

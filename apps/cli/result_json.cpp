@@ -57,6 +57,8 @@ void result_tail(ordered_json& j, const Solution& solution) {
     stats["independent_parts"] = s.independent_parts;
     stats["cluster_tables"] = s.cluster_tables;
     stats["sampled_tables"] = s.sampled_tables;
+    stats["unqueried_links"] = s.unqueried_links;
+    stats["passes"] = s.passes;
     stats["residual"] = s.residual;
     stats["threads"] = s.threads;
     stats["form_factor_time_s"] = s.form_factor_time_s;
