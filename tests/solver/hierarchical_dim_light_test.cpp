@@ -1,0 +1,210 @@
+// The hierarchical solver pays for light only where the solution puts it
+// (solver/hierarchical_solver.h, "The first round" and "Deferred
+// visibility"): in a scene where something can block, the first refinement
+// is against the emission alone, and a link whose error with its
+// transmittance unknown is within a share of the bar never asks the
+// visibility module. Both against the oracle that has neither (the
+// closed-room guess, every surviving link asked) and the exact solver.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fmt/format.h>
+#include <numbers>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "engine/geometry.h"
+#include "engine/scene.h"
+#include "solver/exact_solver.h"
+#include "solver/hierarchical_solver.h"
+
+using namespace flatrad;
+
+namespace {
+
+double point_segment(Vec2 p, const Segment& s) {
+    const Vec2 d = s.b - s.a;
+    const double t = std::clamp(dot(p - s.a, d) / norm_squared(d), 0.0, 1.0);
+    return distance(p, lerp(s.a, s.b, t));
+}
+
+// 0 where they cross, else the least distance from an end to the other.
+double segment_distance(const Segment& s, const Segment& q) {
+    const double o1 = orient(s.a, s.b, q.a), o2 = orient(s.a, s.b, q.b);
+    const double o3 = orient(q.a, q.b, s.a), o4 = orient(q.a, q.b, s.b);
+    if ((o1 > 0) != (o2 > 0) && (o3 > 0) != (o4 > 0)) return 0;
+    return std::min({point_segment(s.a, q), point_segment(s.b, q), point_segment(q.a, s), point_segment(q.b, s)});
+}
+
+// A square room of side `side` (reflectance 0.7, lit inside), a lamp under
+// the ceiling at [0.4, 0.6] of its width (emission 10, lit downwards) and
+// `sticks` two-sided sticks 0.05-0.15 long (reflectance 0.3) at random
+// positions and angles, none within 0.01 of another: the forests of
+// `scripts/make-scene N --density 30` in small.
+std::string forest_json(int sticks, double side, unsigned seed) {
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> U(0, 1);
+    std::vector<Segment> placed;
+    std::string surfaces = fmt::format(
+        R"({{"name": "room", "material": "wall", "closed": true, "side": "in", "points": [[0,0],[{0},0],[{0},{0}],[0,{0}]]}},)"
+        R"({{"name": "lamp", "material": "lamp", "side": "right", "points": [[{1},{2}],[{3},{2}]]}})",
+        side, 0.4 * side, side - 0.03, 0.6 * side);
+    const double margin = 0.1;
+    int tries = 0;
+    while (static_cast<int>(placed.size()) < sticks && ++tries < 1000000) {
+        const double len = 0.05 + 0.1 * U(rng), a = 2 * std::numbers::pi * U(rng);
+        const Vec2 c{margin + (side - 2 * margin) * U(rng), margin + (side - 2 * margin - 0.1) * U(rng)};
+        const Vec2 d{0.5 * len * std::cos(a), 0.5 * len * std::sin(a)};
+        const Segment s{c - d, c + d};
+        if (std::any_of(placed.begin(), placed.end(), [&](const Segment& q) { return segment_distance(s, q) < 0.01; }))
+            continue;
+        placed.push_back(s);
+        surfaces += fmt::format(R"(,{{"name": "t{}", "material": "tree", "side": "both", "points": [[{:.17g},{:.17g}],[{:.17g},{:.17g}]]}})",
+                                placed.size(), s.a.x, s.a.y, s.b.x, s.b.y);
+    }
+    REQUIRE(static_cast<int>(placed.size()) == sticks);
+    return R"({"flatrad": 1, "materials": {"wall": {"reflectance": 0.7}, "tree": {"reflectance": 0.3},
+        "lamp": {"reflectance": 0, "emission": 10}}, "surfaces": [)" + surfaces + "]}";
+}
+
+double relative_l2(const Scene& scene, const Solution& h, const Solution& e) {
+    double num = 0, den = 0;
+    for (size_t p = 0; p < scene.patches.size(); ++p) {
+        const double L = scene.patches[p].length;
+        const double d = h.patches[p].radiosity[0] - e.patches[p].radiosity[0];
+        num += L * d * d;
+        den += L * e.patches[p].radiosity[0] * e.patches[p].radiosity[0];
+    }
+    return std::sqrt(num / den);
+}
+
+HierarchicalOptions oracle_options(double eps) {
+    HierarchicalOptions o;
+    o.eps = eps;
+    o.emission_first = false;
+    o.defer_visibility = false;
+    return o;
+}
+
+}  // namespace
+
+TEST_CASE("hierarchical dim light: a forest's dim links ask nothing, and the error is the oracle's") {
+    // 300 sticks in a room of side 3.2 (data/forest.json's density), against
+    // the exact solve at K = 2 (1210 elements). Every link, deferred or
+    // not, is kept within its share of eps, so the error may differ from
+    // the oracle's only as two solutions of one tolerance do: at most 1.25x
+    // plus 1e-5 (as for chain links, hierarchical_random_test.cpp; measured
+    // 0.99x-1.01x). With deferred links given the whole bar instead of a
+    // tenth (deferred_share 1) eps 2 gives 1.52x: the density's estimate
+    // errs the same way on every deferred link.
+    constexpr double same_error_ratio = 1.25, same_error_floor = 1e-5;
+    // The balance (closed room: the transport's own energy error) may not
+    // be worse than the oracle's by more than 5e-3, half the oracle's own
+    // at eps 0.1 (1.0e-2). Measured: 2.0e-3 / 1.2e-2 / 9.7e-3 against
+    // 5.8e-3 / 1.3e-2 / 1.0e-2 at eps 2 / 0.5 / 0.1; with the whole bar
+    // 4.1e-2 at eps 2.
+    constexpr double balance_slack = 5e-3;
+    const Scene scene = parse_scene(forest_json(300, 3.2, 7), "forest300.json");
+    const Solution exact = solve_exact(scene, {2, 0});
+    for (double eps : {2.0, 0.5, 0.1}) {
+        CAPTURE(eps);
+        HierarchicalOptions o;
+        o.eps = eps;
+        const Solution h = solve_hierarchical(scene, o);
+        const Solution oracle = solve_hierarchical(scene, oracle_options(eps));
+        HierarchicalOptions first_only = oracle_options(eps);
+        first_only.emission_first = true;
+        const Solution f = solve_hierarchical(scene, first_only);
+        const double err = relative_l2(scene, h, exact), err_oracle = relative_l2(scene, oracle, exact),
+                     err_first = relative_l2(scene, f, exact);
+        MESSAGE(fmt::format("eps {}: L2 {:.3e} / {:.3e} / {:.3e} (default / emission first only / oracle), balance {:.2e} / {:.2e} / {:.2e}, links {} / {} / {}, queries {} / {} / {}, unqueried {}, passes {} / {} / {}",
+                            eps, err, err_first, err_oracle, h.totals.balance[0], f.totals.balance[0], oracle.totals.balance[0],
+                            h.stats.links, f.stats.links, oracle.stats.links, h.stats.visibility.queries,
+                            f.stats.visibility.queries, oracle.stats.visibility.queries, h.stats.unqueried_links,
+                            h.stats.passes, f.stats.passes, oracle.stats.passes));
+        CHECK(err <= same_error_ratio * err_oracle + same_error_floor);
+        CHECK(err_first <= same_error_ratio * err_oracle + same_error_floor);
+        CHECK(h.totals.balance[0] <= oracle.totals.balance[0] + balance_slack);
+        CHECK(f.totals.balance[0] <= oracle.totals.balance[0] + balance_slack);
+        // What it is for: fewer queries (measured 0.43x-0.69x of the
+        // oracle's), links carried at the estimate, none in the oracle.
+        CHECK(h.stats.visibility.queries < oracle.stats.visibility.queries);
+        CHECK(f.stats.visibility.queries < oracle.stats.visibility.queries);
+        CHECK(h.stats.unqueried_links > 0);
+        CHECK(oracle.stats.unqueried_links == 0);
+        CHECK(f.stats.unqueried_links == 0);
+        CHECK(h.stats.passes >= 2);  // from the emission alone: at least one more round
+        CHECK(h.stats.passes <= HierarchicalOptions{}.max_passes);
+    }
+}
+
+TEST_CASE("hierarchical dim light: where nothing can block, the first round and every link are as before") {
+    // A convex room: no segment can block, so no link is deferred and the
+    // first refinement is against the closed-room guess whatever the
+    // options: the same links and the same radiosity, bit for bit.
+    const Scene convex = parse_scene(R"({"flatrad": 1, "materials": {"w": {"reflectance": 0.6},
+        "lamp": {"emission": 1}}, "surfaces": [
+        {"name": "lamp", "material": "lamp", "points": [[0,0],[1,0]], "side": "left"},
+        {"name": "walls", "material": "w", "points": [[1,0],[2,0.5],[2,2],[0.5,2.5],[-0.5,1],[0,0]], "side": "left"}]})",
+                                     "convex.json");
+    HierarchicalOptions o;
+    o.eps = 1e-3;
+    const Solution a = solve_hierarchical(convex, o);
+    o.emission_first = false;
+    o.defer_visibility = false;
+    const Solution b = solve_hierarchical(convex, o);
+    CHECK(a.stats.visibility.queries == 0);
+    CHECK(a.stats.unqueried_links == 0);
+    CHECK(a.stats.links == b.stats.links);
+    CHECK(a.stats.passes == b.stats.passes);
+    REQUIRE(a.patches.size() == b.patches.size());
+    for (size_t p = 0; p < a.patches.size(); ++p) CHECK(a.patches[p].radiosity == b.patches[p].radiosity);
+}
+
+TEST_CASE("hierarchical dim light: light behind a screen of sticks is still found") {
+    // A lamp in the left third of a long room, a screen of sticks across
+    // it (three staggered columns of short slanted sticks, with gaps), and
+    // a plate facing it at the far end. From the emission alone the first
+    // round refines nothing beyond the screen, and links there are carried
+    // at the density's estimate until their senders are lit. The light
+    // that passes must still be found, as the oracle finds it.
+    std::string surfaces = R"({"name": "room", "material": "wall", "closed": true, "side": "in", "points": [[0,0],[6,0],[6,1],[0,1]]},
+        {"name": "lamp", "material": "lamp", "side": "right", "points": [[0.4,0.95],[1.2,0.95]]},
+        {"name": "far", "material": "wall", "side": "left", "points": [[5.9,0.05],[5.9,0.95]]})";
+    int n = 0;
+    for (int col = 0; col < 3; ++col)
+        for (int k = 0; k < 12; ++k) {
+            const double x = 2.0 + 0.08 * col, y = 0.06 + 0.075 * k + 0.025 * col;
+            surfaces += fmt::format(R"(,{{"name": "s{}", "material": "tree", "side": "both", "points": [[{},{}],[{},{}]]}})", n++,
+                                    x - 0.02, y, x + 0.02, y + 0.04);
+        }
+    const Scene scene = parse_scene(R"({"flatrad": 1, "materials": {"wall": {"reflectance": 0.7}, "tree": {"reflectance": 0.3},
+        "lamp": {"reflectance": 0, "emission": 10}}, "surfaces": [)" + surfaces + "]}", "screen.json");
+    const int far_surface = scene.find_surface("far");
+    size_t far = 0;
+    while (scene.patches[far].surface != far_surface) ++far;
+    // The exact solver's uniform mesh converges slowly on the 6-long walls:
+    // the far plate's radiosity is 0.181 / 0.0926 / 0.0647 / 0.0603 / 0.0582
+    // at K = 2 / 4 / 8 / 16 / 32, so K = 32 is itself ~4% from the limit
+    // (first-order extrapolation 0.0560); the hierarchical solution (which
+    // refines the walls where they need it) is 0.0586 at eps 1e-3.
+    const Solution exact = solve_exact(scene, {32, 0});
+    constexpr double exact_tol = 0.05;  // the K = 32 reference's own ~4%, with a margin
+    // Deferred or not, each link within its share of eps: the far plate
+    // as the oracle's to 2% (measured 0.3% at eps 1e-3, 0.5% at 1e-2).
+    constexpr double oracle_tol = 0.02;
+    HierarchicalOptions o;
+    o.eps = 1e-3;
+    const Solution h = solve_hierarchical(scene, o);
+    const Solution oracle = solve_hierarchical(scene, oracle_options(o.eps));
+    const double want = exact.patches[far].radiosity[0];
+    const double got = h.patches[far].radiosity[0], got_oracle = oracle.patches[far].radiosity[0];
+    MESSAGE(fmt::format("far plate: exact K = 32 {:.4e}, default {:.4e}, oracle {:.4e}; unqueried links {}", want, got,
+                        got_oracle, h.stats.unqueried_links));
+    REQUIRE(want > 0);
+    CHECK(h.stats.unqueried_links > 0);
+    CHECK(std::abs(got - want) <= exact_tol * want);
+    CHECK(std::abs(got - got_oracle) <= oracle_tol * got_oracle);
+}
