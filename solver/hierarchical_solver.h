@@ -82,7 +82,9 @@
 ///    rounds; stats.passes). The guess, where nothing can block: every
 ///    patch at E + rho B_bar, B_bar the radiosity of a closed room with the
 ///    scene's emission and absorption (every patch that faces an emitter
-///    sees it). Where something can block, the emission alone (B = E), so
+///    sees it). Where blockers make at least 4 layers of shadow across the
+///    scene (its density, MultiscaleVisibility::layers_per_depth, times
+///    the root box's longer side), the emission alone (B = E), so
 ///    that light is paid for only where the solution puts it: the guess
 ///    put a 10^4-segment forest's every stick at 0.008, above the
 ///    radiosity that 18 000 of its 20 000 patches end with, and refinement
@@ -155,9 +157,10 @@ struct HierarchicalOptions {
     /// is within eps (see above); off: refined like any other pair (the same
     /// accuracy with more links, for tests).
     bool chain_links = true;
-    /// Where something can block, the first refinement is against the
-    /// emission alone (see above); off: against the closed-room guess, as
-    /// where nothing can block (more links and queries, for tests).
+    /// Where blockers make 4 layers of shadow or more across the scene, the
+    /// first refinement is against the emission alone (see above); off:
+    /// against the closed-room guess everywhere (more links and queries in
+    /// forests, for tests).
     bool emission_first = true;
     /// Deferred visibility (see above); off: every link that survives its
     /// geometry asks the visibility module (for tests: the oracle).
