@@ -306,8 +306,7 @@ double chain_self_etendue(Vec2 a0, Vec2 a1, double length, double& rounding) {
 // unoccluded coefficient is kept in l.Fu (an element link's own; a cluster
 // link's, which has no Fu, rounded to a float: only the error estimate
 // reads it there, resolve_visibility computes it again).
-void defer_visibility(Link& l, double tau_est) {
-    const bool element = l.Fu > 0;
+void defer_visibility(Link& l, double tau_est, bool element) {
     if (!element) l.Fu = static_cast<float>(l.coef);
     l.vis_pending = true;
     l.coef *= tau_est;
@@ -384,12 +383,12 @@ public:
         m_vis.set_min_pieces_to_approximate(min_pieces_to_approximate);
         m_vis.set_min_pieces_to_bound(min_pieces_to_bound);
         m_vis.set_min_pieces_to_prove_closed(min_pieces_to_prove_closed);  // (after set_blockers: see there)
+        m_unblockable = std::find(blockers.begin(), blockers.end(), 1) == blockers.end();
         m_kappa = m_vis.layers_per_depth();
         if (m_opt.emission_first && !m_unblockable && m_hierarchy.root() >= 0) {
             const Vec2 e = m_hierarchy.node(m_hierarchy.root()).box.extent();
             m_emission_first = m_kappa * std::max(e.x, e.y) >= emission_first_layers;
         }
-        m_unblockable = std::find(blockers.begin(), blockers.end(), 1) == blockers.end();
         // A few things inside a room (a lamp, a pillar): chain links check
         // them one by one (chain_clear); with more, none is made.
         if (std::count(blockers.begin(), blockers.end(), 1) <= max_chain_blockers) {
@@ -1099,7 +1098,7 @@ bool HierarchicalSolver::make_link(int r, int s, Link& l, VisibilityStats& st) c
         if (!m_unblockable && !l.clear) {
             // Visibility is asked later, if the link survives its geometry
             // and its sender is bright enough (refine; resolve_visibility).
-            defer_visibility(l, prior_transmittance(nr, ns));
+            defer_visibility(l, prior_transmittance(nr, ns), true);
             return true;
         }
         ++st.unoccluded;
@@ -1191,7 +1190,7 @@ bool HierarchicalSolver::make_link(int r, int s, Link& l, VisibilityStats& st) c
     }
     // The transmittance is asked later, and only if the link survives its
     // geometry and its sender is bright enough (refine; resolve_visibility).
-    defer_visibility(l, prior_transmittance(nr, ns));
+    defer_visibility(l, prior_transmittance(nr, ns), false);
     return true;
 }
 
@@ -1223,7 +1222,6 @@ double HierarchicalSolver::prior_transmittance(const Node& r, const Node& s) con
     const double gap = std::max(0.0, range(r).first - range(s).second);
     return std::exp(-m_kappa * gap);
 }
-
 
 // A cluster link's coefficient at tau = 1 (see Link).
 double HierarchicalSolver::unoccluded_coef(const Node& nr, const Node& ns) const {
@@ -1775,6 +1773,7 @@ bool HierarchicalSolver::refine(const std::vector<double>& leaf_bmax, double exi
                 // round surely splits, and no link keeps a pending
                 // visibility if it turns out not to.)
                 if (l.vis_pending) {
+                    double geometric = 0;
                     if (can_r || can_s) {
                         const LinkError g = error(true);
                         if (g.err > eps_abs) {
@@ -1782,12 +1781,16 @@ bool HierarchicalSolver::refine(const std::vector<double>& leaf_bmax, double exi
                             above = true;
                             continue;
                         }
+                        geometric = g.err;
                     }
                     // Within its share of the bar with the visibility
                     // unknown (the density's estimate, any truth in [0, 1]):
                     // kept so, no query (a dim sender's links; asked again
-                    // in later rounds, against the new solution).
-                    if (m_opt.defer_visibility && error(false).err <= deferred_share * split_at) continue;
+                    // in later rounds, against the new solution). The
+                    // geometric terms are part of that error: above the
+                    // share already, it need not be computed.
+                    const double deferred_bar = deferred_share * split_at;
+                    if (m_opt.defer_visibility && geometric <= deferred_bar && error(false).err <= deferred_bar) continue;
                     ++asked;
                     if (!resolve_visibility(l, ws, local)) {
                         decision[static_cast<size_t>(k)] = 4;  // nothing passes: dropped
