@@ -19,8 +19,10 @@
 #include "engine/scene.h"
 #include "solver/exact_solver.h"
 #include "solver/hierarchical_solver.h"
+#include "support/relative_l2.h"
 
 using namespace flatrad;
+using flatrad::test::relative_l2;
 
 namespace {
 
@@ -69,16 +71,6 @@ std::string forest_json(int sticks, double side, unsigned seed) {
         "lamp": {"reflectance": 0, "emission": 10}}, "surfaces": [)" + surfaces + "]}";
 }
 
-double relative_l2(const Scene& scene, const Solution& h, const Solution& e) {
-    double num = 0, den = 0;
-    for (size_t p = 0; p < scene.patches.size(); ++p) {
-        const double L = scene.patches[p].length;
-        const double d = h.patches[p].radiosity[0] - e.patches[p].radiosity[0];
-        num += L * d * d;
-        den += L * e.patches[p].radiosity[0] * e.patches[p].radiosity[0];
-    }
-    return std::sqrt(num / den);
-}
 
 HierarchicalOptions oracle_options(double eps) {
     HierarchicalOptions o;

@@ -14,9 +14,11 @@
 #include "engine/scene.h"
 #include "solver/exact_solver.h"
 #include "solver/hierarchical_solver.h"
+#include "support/relative_l2.h"
 #include "support/random_rooms.h"
 
 using namespace flatrad;
+using flatrad::test::relative_l2;
 
 namespace {
 
@@ -34,17 +36,6 @@ std::string room_json(const test::RandomRoom& room, int per_wall, std::mt19937_6
                                 room.segments[s].a.x, room.segments[s].a.y, room.segments[s].b.x, room.segments[s].b.y);
     }
     return fmt::format(R"({{"flatrad": 1, "materials": {{{}}}, "surfaces": [{}]}})", materials, surfaces);
-}
-
-double relative_l2(const Scene& scene, const Solution& h, const Solution& e) {
-    double num = 0, den = 0;
-    for (size_t p = 0; p < scene.patches.size(); ++p) {
-        const double L = scene.patches[p].length;
-        const double d = h.patches[p].radiosity[0] - e.patches[p].radiosity[0];
-        num += L * d * d;
-        den += L * e.patches[p].radiosity[0] * e.patches[p].radiosity[0];
-    }
-    return std::sqrt(num / den);
 }
 
 }  // namespace

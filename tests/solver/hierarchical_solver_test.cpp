@@ -2,6 +2,7 @@
 // white furnace, convergence to the exact solver as eps shrinks, energy
 // balance, refusal of a closed reflectance-1 room.
 #include "solver/hierarchical_solver.h"
+#include "support/relative_l2.h"
 
 #include <doctest/doctest.h>
 
@@ -14,6 +15,7 @@
 #include "solver/exact_solver.h"
 
 using namespace flatrad;
+using flatrad::test::relative_l2;
 
 namespace {
 
@@ -51,18 +53,6 @@ const char* shadow_box = R"({"flatrad": 1, "name": "shadow box",
     {"name": "shelf", "material": "dark", "points": [[0.8,1.0],[2.0,1.2]], "side": "both"}
   ]})";
 
-// Relative L2 error of per-patch radiosity, length-weighted over all channels.
-double relative_l2(const Scene& scene, const Solution& h, const Solution& e) {
-    double num = 0, den = 0;
-    for (size_t p = 0; p < scene.patches.size(); ++p)
-        for (int c = 0; c < scene.channels; ++c) {
-            const double L = scene.patches[p].length;
-            const double d = h.patches[p].radiosity[static_cast<size_t>(c)] - e.patches[p].radiosity[static_cast<size_t>(c)];
-            num += L * d * d;
-            den += L * e.patches[p].radiosity[static_cast<size_t>(c)] * e.patches[p].radiosity[static_cast<size_t>(c)];
-        }
-    return std::sqrt(num / den);
-}
 
 }  // namespace
 
