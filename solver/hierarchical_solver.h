@@ -90,6 +90,7 @@
 ///    radiosity that 18 000 of its 20 000 patches end with, and refinement
 ///    only splits. (eps_abs of that first round is the closed room's:
 ///    the emission alone would make it too fine near the emitters.)
+///    stats.first_round says which start was taken.
 ///  - Deferred visibility: a link's visibility is asked only when the link
 ///    survives its geometry and its error with the transmittance unknown
 ///    (an estimate tau_est, any truth in [0, 1]: a bound of max(tau_est,
