@@ -94,7 +94,9 @@
 ///  - Deferred visibility: a link's visibility is asked only when the link
 ///    survives its geometry and its error with the transmittance unknown
 ///    (an estimate tau_est, any truth in [0, 1]: a bound of max(tau_est,
-///    1 - tau_est)) exceeds eps_abs; until then it carries tau_est, the
+///    1 - tau_est)) exceeds a tenth of eps_abs (deferred_share in the
+///    .cpp: these estimates err the same way on every link of a scene, so
+///    their errors add up); until then it carries tau_est, the
 ///    transmittance of blockers spread at the scene's mean density over
 ///    the gap between its nodes, exp(-kappa g) (kappa: layers of shadow
 ///    per unit of depth, MultiscaleVisibility::layers_per_depth). A
