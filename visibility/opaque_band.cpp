@@ -58,9 +58,9 @@ double uncovered(const Band& band, int s, double c, double h, const size_t* item
     const Vec2 O{band.t0, band.ya + (s + 0.5) * band.w};
     auto& shadows = ws.shadows;
     shadows.clear();
-    const Vec2* local = ws.local.data();
+    const Vec2* ends = ws.run_ends.data() + band.ends_first;  // items: positions in the band's run
     for (size_t it = 0; it < count; ++it) {
-        const Vec2 p = local[2 * items[it]] - O, q = local[2 * items[it] + 1] - O;
+        const Vec2 p = ends[2 * items[it]] - O, q = ends[2 * items[it] + 1] - O;
         const Interval sh = held(nx * p.x + ny * p.y, norm(p) * h, nx * q.x + ny * q.y, norm(q) * h);
         if (sh.b > sh.a && sh.b > window.a && sh.a < window.b) shadows.push_back(sh);
     }
@@ -90,17 +90,17 @@ double band_free(const Band& band, double c, double h, double bar, OpaqueBandScr
     // a piece's shadow at c lies between its ends' offsets, and its held
     // shadow within that.
     const double nx = -std::sin(c), ny = std::cos(c), span = ny * band.w, pad = 0.5 * band.w * h;
-    const Vec2* local = ws.local.data();
     const int S = band.sections;
     auto& first_of = ws.bucket_first;
     auto& items = ws.bucket_items;
     auto& range = ws.bucket_range;
     first_of.assign(static_cast<size_t>(S) + 1, 0);
     range.resize(band.last - band.first);
-    for (size_t r = band.first; r < band.last; ++r) {
-        const size_t q = ws.index[r];
-        const double pp = nx * (local[2 * q].x - band.t0) + ny * (local[2 * q].y - band.ya);
-        const double pq = nx * (local[2 * q + 1].x - band.t0) + ny * (local[2 * q + 1].y - band.ya);
+    // (The band's ends in run order: build_band; items are run positions.)
+    const Vec2* end = ws.run_ends.data() + band.ends_first;
+    for (size_t r = band.first; r < band.last; ++r, end += 2) {
+        const double pp = nx * (end[0].x - band.t0) + ny * (end[0].y - band.ya);
+        const double pq = nx * (end[1].x - band.t0) + ny * (end[1].y - band.ya);
         const double lo = std::floor((std::min(pp, pq) - pad) / span), hi = std::floor((std::max(pp, pq) + pad) / span);
         const int a = static_cast<int>(std::clamp(lo, 0.0, static_cast<double>(S)));
         const int b = static_cast<int>(std::clamp(hi, -1.0, S - 1.0));
@@ -113,7 +113,7 @@ double band_free(const Band& band, double c, double h, double bar, OpaqueBandScr
     fill.assign(first_of.begin(), first_of.end() - 1);
     for (size_t r = band.first; r < band.last; ++r) {
         const auto [a, b] = range[r - band.first];
-        for (int sct = a; sct <= b; ++sct) items[fill[static_cast<size_t>(sct)]++] = ws.index[r];
+        for (int sct = a; sct <= b; ++sct) items[fill[static_cast<size_t>(sct)]++] = r - band.first;
     }
     double sum = 0;
     for (int sct = 0; sct < S && sum <= bar; ++sct) {
@@ -184,6 +184,7 @@ double band_bound(const Segment& ci, const Segment& cj, const Segment* blockers,
 
     ws.points.clear();
     ws.radius.clear();
+    ws.run_ends.clear();
     auto& bands = ws.bands;
     bands.clear();
     // Band k (the middle one first); returns the widest bin half-width at
@@ -216,13 +217,21 @@ double band_bound(const Segment& ci, const Segment& cj, const Segment* blockers,
         }
         const size_t taken = right - left;
         if (taken == 0 || !(across > 0)) return 0.0;
+        // The run's ends, in run order, for band_free's bins and their
+        // sections: read in sequence there, bin after bin.
+        const size_t ends_first = ws.run_ends.size();
+        for (size_t r = left; r < right; ++r) {
+            const size_t q = index[r];
+            for (size_t end = 0; end < 2; ++end)
+                ws.run_ends.push_back(local[2 * q + end]);
+        }
         // X in sections a few mean shadows wide, each turned about its own
         // midpoint: the drift grows with the distance to the centre.
         const double mean_shadow = across / static_cast<double>(taken);
         const double wanted = std::ceil((yb - ya) / (opaque_band_section_shadows * mean_shadow));
         const int S = static_cast<int>(std::clamp(wanted, 1.0, static_cast<double>(opaque_band_max_sections)));
         const double w = (yb - ya) / S;
-        bands.push_back({t0, ya, w, S, left, right, ws.points.size()});
+        bands.push_back({t0, ya, w, S, left, right, ws.points.size(), ends_first});
         for (int s = 0; s < S; ++s) {
             const double y0 = ya + w * s, y1 = ya + w * (s + 1);
             const Vec2 O{t0, 0.5 * (y0 + y1)};
