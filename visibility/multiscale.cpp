@@ -790,8 +790,9 @@ MultiscaleResult MultiscaleVisibility::form_factor_skipping(const Segment& i, co
     // it, for a few small sorts; the bound's midpoint is the answer, as for
     // the direction bounds below. True when that settles the query (`out`
     // holds the answer).
-    auto settled_by_bands = [&](const std::vector<Segment>& whole) {
+    auto settled_by_bands = [&](const std::vector<Segment>& whole, const double* depths) {
         BandOptions band;  // eps = 0: the proof of closure alone
+        band.depths = depths;
         if (eps > 0) {
             band.limit = 2 * eps * g.L_i;
             band.drift = band_bound_drift;
@@ -817,18 +818,38 @@ MultiscaleResult MultiscaleVisibility::form_factor_skipping(const Segment& i, co
     //    (band_slab_layers each) are walked first, alone; if their bands
     //    settle the query, the rest of the shaft is never walked. Otherwise
     //    the walk below starts over.
+    //    The slabs lie side by side from the shaft's narrower end: a band
+    //    needs fewest pieces where the section is narrowest, and the
+    //    section grows linearly with depth, so at the far end of a link
+    //    from an element to a cluster metres away it can be many times
+    //    wider, and the pieces to walk and to sort with it. (On the 10^5
+    //    forest at eps 10: 52.8 s with the slabs evenly spaced, 35.9 s with
+    //    these, 566 and 359 million cluster visits. The same placement for
+    //    the whole shaft's bands below, after the slabs: 37.4 s, and the
+    //    balance 1.1% against 0.5%: not kept.)
     if (m_layers_per_depth > 0 && m_min_pieces_to_prove_closed != std::numeric_limits<size_t>::max()) {
         auto at_depth = [&](Vec2 p) { return dot(p - g.origin, g.u); };  // the pair's frame (PairFrame)
         const double xi = std::max(at_depth(g.ci.a), at_depth(g.ci.b));
         const double xj = std::min(at_depth(g.cj.a), at_depth(g.cj.b));
         const double depth = xj - xi;
+        static_assert(long_shaft_layers >= opaque_band_count * band_slab_layers, "the slabs fit in a long shaft");
         if (std::isfinite(depth) && depth * m_layers_per_depth >= long_shaft_layers) {
-            const double half = 0.5 * band_slab_layers / m_layers_per_depth;
-            double slab_lo[opaque_band_count], slab_hi[opaque_band_count];
+            const double slab = band_slab_layers / m_layers_per_depth, half = 0.5 * slab;
+            const auto lateral = [&](Vec2 p) { return dot(p - g.origin, rot90(g.u)); };
+            const auto side_at = [&](double t, Vec2 p, Vec2 q) {  // the side p -> q at depth t
+                const double tp = at_depth(p), tq = at_depth(q);
+                return lateral(p) + (t - tp) / (tq - tp) * (lateral(q) - lateral(p));
+            };
+            // The sides A1 -> C0 and C1 -> A0 (opaque_band.cpp).
+            const auto width_at = [&](double t) {
+                return std::abs(side_at(t, g.ci.b, g.cj.a) - side_at(t, g.cj.b, g.ci.a));
+            };
+            const bool from_i = width_at(xi) <= width_at(xj);
+            double t0[opaque_band_count], slab_lo[opaque_band_count], slab_hi[opaque_band_count];
             for (int k = 0; k < opaque_band_count; ++k) {
-                const double t0 = xi + depth * (k + 0.5) / opaque_band_count;  // as band_bound places them
-                slab_lo[k] = t0 - half;
-                slab_hi[k] = t0 + half;
+                t0[k] = from_i ? xi + (k + 0.5) * slab : xj - (k + 0.5) * slab;  // the bands' depths
+                slab_lo[k] = t0[k] - half;
+                slab_hi[k] = t0[k] + half;
             }
             auto in_slabs = [&](double lo, double hi) {
                 for (int k = 0; k < opaque_band_count; ++k)
@@ -857,7 +878,7 @@ MultiscaleResult MultiscaleVisibility::form_factor_skipping(const Segment& i, co
                 if (!clipped.empty()) found.push_back(b);
                 return alone;
             });
-            if (closed || (found.size() >= m_min_pieces_to_prove_closed && settled_by_bands(found))) {
+            if (closed || (found.size() >= m_min_pieces_to_prove_closed && settled_by_bands(found, t0))) {
                 stats.clusters_visited += out.clusters_visited;
                 ++stats.queries;
                 ++stats.slabs;
@@ -885,7 +906,7 @@ MultiscaleResult MultiscaleVisibility::form_factor_skipping(const Segment& i, co
     stats.clusters_visited += out.clusters_visited;
     ++stats.queries;
     // 1b. A crowded shaft: bands first.
-    if (!separated && pieces.size() >= m_min_pieces_to_prove_closed && settled_by_bands(whole)) return out;
+    if (!separated && pieces.size() >= m_min_pieces_to_prove_closed && settled_by_bands(whole, nullptr)) return out;
     //     A crowded shaft, a loose tolerance: bounds by direction bins
     //     (direction_bounds.h) may meet it for much less than the exact
     //     integral or the mixed one; they are tried with a budget.

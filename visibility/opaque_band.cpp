@@ -166,9 +166,17 @@ double band_bound(const Segment& ci, const Segment& cj, const Segment* blockers,
         // few in all, no band closes the shaft and the attempt is skipped.
         double across = 0;
         for (size_t q = 0; q < n; ++q) across += std::abs(local[2 * q + 1].y - local[2 * q].y);
+        // Where the caller chose the bands' depths it passed the pieces
+        // around them alone: enough layers for one band at its section,
+        // the narrowest of theirs.
         const auto width_at = [&](double t) { return std::abs(y_at(t, A1, C0) - y_at(t, C1, A0)); };
-        const double mean_width = 0.5 * (width_at(xi) + width_at(xj));
-        if (!(across >= opaque_band_min_layers * mean_width)) return not_shown;
+        double width = 0.5 * (width_at(xi) + width_at(xj));
+        if (options.depths) {
+            width = not_shown;
+            for (int k = 0; k < opaque_band_count; ++k)
+                width = std::min(width, width_at(std::clamp(options.depths[k], xi, xj)));
+        }
+        if (!(across >= opaque_band_min_layers * width)) return not_shown;
     }
     // The pieces by the depth of their midpoints: a band is a run of them
     // around its depth.
@@ -191,8 +199,7 @@ double band_bound(const Segment& ci, const Segment& cj, const Segment* blockers,
     // which its pieces drift by at most options.drift of their mean shadow
     // (0: no piece).
     auto build_band = [&](int k) {
-        const int slot = (k + opaque_band_count / 2) % opaque_band_count;
-        const double t0 = xi + (xj - xi) * (slot + 0.5) / opaque_band_count;
+        const double t0 = options.depths ? std::clamp(options.depths[k], xi, xj) : band_depth(k, xi, xj);
         // The shaft's sides are the edges A1 -> C0 and C1 -> A0, the only
         // two that cross x = t for t between the patches.
         const bool side1_low = y_at(t0, A1, C0) <= y_at(t0, C1, A0);

@@ -83,7 +83,8 @@ inline constexpr int opaque_band_count = 3;
 /// opaque_band_max_pieces.
 inline constexpr double opaque_band_layers = 6;
 /// Shafts whose pieces' shadows add up to fewer layers than this over the
-/// whole slab (their sum over the shaft's mean width) are not tried: a
+/// whole slab (their sum over the shaft's mean width; with the bands'
+/// depths given, over the narrowest of their sections) are not tried: a
 /// band holds a share of them. (On the 10^3 forest of `scripts/bench
 /// versus` at eps 4, trying from 0 layers took 14% more instructions than
 /// from 8, for 13% more shafts shown closed.)
@@ -126,7 +127,18 @@ struct BandOptions {
     double limit = 0;  ///< give up once the bound would exceed this (0: the proof of closure)
     double max_checks = opaque_band_max_checks;  ///< see above
     double drift = opaque_band_drift;            ///< bins narrow enough for this drift (see above)
+    /// The bands' depths t0 along the pair's axis (PairFrame of ci, cj),
+    /// the first built first, each within the slab between the patches;
+    /// null: evenly spaced (band_depth), the middle one first.
+    const double* depths = nullptr;
 };
+
+/// Depth of band k (0 first) with evenly spaced bands between xi and xj:
+/// the middle one first, then the one nearer j, then the one nearer i.
+inline double band_depth(int k, double xi, double xj) {
+    const int slot = (k + opaque_band_count / 2) % opaque_band_count;
+    return xi + (xj - xi) * (slot + 0.5) / opaque_band_count;
+}
 
 /// An upper bound on L_i F_ij, the exchange of ci and cj (a mutually
 /// clipped facing pair lit on the left) through the blockers (whole

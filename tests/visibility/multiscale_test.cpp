@@ -238,6 +238,55 @@ TEST_CASE("multiscale: a long shaft's bands settle it from their slabs alone, wi
     }
 }
 
+TEST_CASE("multiscale: a long tapered shaft's slabs lie at its narrow end") {
+    // A short patch i (length 1) and a wide j (31) 30 apart: the shaft's
+    // section grows from 1 to 31. A blind closes it within 3 of i (pairs of
+    // rows 0.05 apart, sticks 0.3 long with gaps of 0.1 and 0.4 long
+    // centred on those gaps, from x = -3 to 4: the shaft is at most 2.5
+    // wide there and its lines turn by less than 0.5, so each pair stops
+    // them all); nothing else is in the shaft. Long rows outside it, on its
+    // left, give the scene the density of a long shaft (about 80 layers
+    // between the patches by the root box's density, past the 36 of a long
+    // shaft), slabs about 3 deep. Slabs evenly spaced along the shaft
+    // (around 5, 15 and 25) hold nothing of the blind; slabs from the
+    // narrow end (around 1.5, 4.5 and 7.5) hold it: closed, exactly, from
+    // the slabs alone, asked from either end.
+    constexpr double D = 30;
+    test::Cloud c;
+    c.i = {{0, 0}, {1, 0}};
+    c.j = {{16, D}, {-15, D}};
+    c.segments = {c.i, c.j};
+    for (double y = 0.4; y < 3; y += 0.4) {
+        for (double x = -3; x < 4; x += 0.4) c.segments.push_back({{x, y}, {x + 0.3, y}});
+        for (double x = -2.85; x < 4; x += 0.4) c.segments.push_back({{x, y + 0.05}, {x + 0.4, y + 0.05}});
+    }
+    // The shaft's left side runs from (0, 0) to (-15, 30): x = -y / 2.
+    for (double y = 0.2; y < D - 1; y += 0.05) c.segments.push_back({{-15, y}, {-0.5 * y - 1, y}});
+    test::CloudVisibility vis(c);
+    vis.multiscale.set_min_pieces_to_bound(32);
+    vis.multiscale.set_min_pieces_to_prove_closed(16);
+    const double layers = vis.multiscale.layers_per_depth() * D;
+    CAPTURE(layers);
+    REQUIRE(layers >= 72);  // a long shaft, slabs 8 layers thick: 3.3 deep at most
+    ExactWorkspace ws;
+    VisibilityStats st, ex_st;
+    const double unocc = form_factor_unoccluded(c.i, c.j);
+    REQUIRE(vis.exact.form_factor(c.i, c.j, 0, 1, ws, ex_st) <= rounding_floor * unocc);  // closed
+    for (const double eps : {0.0, 1e-3 * unocc}) {
+        CAPTURE(eps);
+        const long slabs_before = st.slabs;
+        const MultiscaleResult r = vis.multiscale.form_factor(c.i, c.j, 0, 1, eps, GammaRule::Bound, ws, st);
+        CHECK(r.F == 0);
+        CHECK(r.error_bound == 0);
+        CHECK(st.slabs == slabs_before + 1);  // settled by the slabs alone
+        // And the same shaft from j's side: the narrow end is now the far one.
+        const long slabs_reversed = st.slabs;
+        const MultiscaleResult back = vis.multiscale.form_factor(c.j, c.i, 1, 0, eps, GammaRule::Bound, ws, st);
+        CHECK(back.F == 0);
+        CHECK(st.slabs == slabs_reversed + 1);
+    }
+}
+
 TEST_CASE("multiscale: transmittance between clusters is in [0, 1] and within its bound of eps = 0") {
     std::mt19937_64 rng(5);
     test::Cloud c = test::make_cloud(rng);
