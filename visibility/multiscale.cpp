@@ -760,20 +760,26 @@ MultiscaleResult MultiscaleVisibility::form_factor_skipping(const Segment& i, co
     // skipped) of each leaf whose box overlaps the shaft and passes box_ok
     // to take(position, segment), which says whether that closes the shaft
     // (the walk then stops: returns true).
+    // A node whose box is surely inside the shaft goes on the stack as
+    // -1 - node: its descendants are inside too, and are not tested again.
     auto walk = [&](auto&& box_ok, auto&& take) {
         bool closed = false;
         auto& stack = ws.stack;
         stack.clear();
         if (m_hierarchy->root() >= 0) stack.push_back(m_hierarchy->root());
         while (!stack.empty() && !closed) {
-            const ClusterNode& n = m_hierarchy->node(stack.back());
+            const int top = stack.back();
             stack.pop_back();
+            const bool known_inside = top < 0;
+            const ClusterNode& n = m_hierarchy->node(known_inside ? -1 - top : top);
             if (n.blockers == 0) continue;  // nothing below can block (Hierarchy::set_blockers)
             ++out.clusters_visited;
-            if (!shaft.overlaps(n.box) || !box_ok(n.box)) continue;
+            const Shaft::Where w = known_inside ? Shaft::Where::inside : shaft.where(n.box);
+            if (w == Shaft::Where::outside || !box_ok(n.box)) continue;
             if (!n.leaf()) {
-                stack.push_back(n.child[1]);
-                stack.push_back(n.child[0]);
+                const bool inside = w == Shaft::Where::inside;
+                stack.push_back(inside ? -1 - n.child[1] : n.child[1]);
+                stack.push_back(inside ? -1 - n.child[0] : n.child[0]);
                 continue;
             }
             for (int q = n.first; q < n.first + n.count && !closed; ++q) {

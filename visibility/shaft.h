@@ -67,19 +67,28 @@ struct Shaft {
     // furthest along the edge's normal, n . (centre - p) + |n| . half
     // extent, is outside by more than culling_slack of the magnitudes). A
     // box within that margin of an edge counts as overlapping.
-    bool overlaps(const Box& b) const {
-        if (b.hi.x < box.lo.x || b.lo.x > box.hi.x || b.hi.y < box.lo.y || b.lo.y > box.hi.y) return false;
+    bool overlaps(const Box& b) const { return where(b) != Where::outside; }
+
+    // The same test, telling also a box surely inside: for every edge, the
+    // corner furthest against its normal, n . (centre - p) - |n| . half
+    // extent, is inside by more than the margin. (Surely: then so is every
+    // box within it, which need not be tested again.)
+    enum class Where { outside, across, inside };
+    Where where(const Box& b) const {
+        if (b.hi.x < box.lo.x || b.lo.x > box.hi.x || b.hi.y < box.lo.y || b.lo.y > box.hi.y) return Where::outside;
         const Vec2 c = b.center();
         const Vec2 h = 0.5 * b.extent();
         const double size = std::max(std::abs(c.x), std::abs(c.y)) + h.x + h.y;
+        bool inside = true;
         for (size_t e = 0; e < 4; ++e) {
             if (!edge_ok[e]) continue;
             const Vec2 n = normal[e], r = c - v[e];
-            const double top = n.x * r.x + n.y * r.y + std::abs(n.x) * h.x + std::abs(n.y) * h.y;
+            const double mid = n.x * r.x + n.y * r.y, spread = std::abs(n.x) * h.x + std::abs(n.y) * h.y;
             const double margin = culling_slack * normal_l1[e] * (size + std::max(std::abs(r.x), std::abs(r.y)));
-            if (top < -margin) return false;
+            if (mid + spread < -margin) return Where::outside;
+            inside = inside && mid - spread > margin;
         }
-        return true;
+        return inside ? Where::inside : Where::across;
     }
 
     // The box lies wholly inside the closed shaft (all four corners).

@@ -99,6 +99,18 @@ Pair random_pair(std::mt19937_64& rng, double scale, Vec2 offset) {
     return {{place(a), place(b)}, {place(c), place(d)}};
 }
 
+// A box of size up to `size` (times scale) centred within `spread` of the
+// pair's middle (0, 1), a little lopsided.
+Box random_box(std::mt19937_64& rng, double scale, Vec2 offset, double spread, double size) {
+    std::uniform_real_distribution<double> u(-1, 1);
+    const Vec2 c = offset + scale * Vec2{spread * u(rng), 1 + spread * u(rng)};
+    const double r = scale * size * std::abs(u(rng));
+    Box b;
+    b.add(c - Vec2{r, 0.7 * r});
+    b.add(c + Vec2{0.4 * r, r});
+    return b;
+}
+
 }  // namespace
 
 TEST_CASE("shaft: culling never drops a box the corner test keeps, and still culls what is clearly out") {
@@ -120,11 +132,7 @@ TEST_CASE("shaft: culling never drops a box the corner test keeps, and still cul
             const Pair pr = random_pair(rng, scale, offset);
             const Shaft s(pr.i, pr.j);
             for (int k = 0; k < 50; ++k) {
-                Box b;
-                const Vec2 c = offset + scale * Vec2{2.5 * u(rng), 1 + 2.5 * u(rng)};
-                const double r = scale * 0.3 * std::abs(u(rng));
-                b.add(c - Vec2{r, 0.7 * r});
-                b.add(c + Vec2{0.4 * r, r});
+                const Box b = random_box(rng, scale, offset, 2.5, 0.3);
                 const bool oracle = overlaps_oracle(s, b), fast = s.overlaps(b);
                 if (oracle) {
                     CHECK(fast);  // never drops an overlapping box
@@ -144,6 +152,45 @@ TEST_CASE("shaft: culling never drops a box the corner test keeps, and still cul
             CHECK(clearly_out > 1000);
             CHECK(culled >= clearly_out);
         }
+    }
+}
+
+// Every corner of the box inside the closed shaft (the FMA orientation).
+bool inside_oracle(const Shaft& s, const Box& b) {
+    const std::array<Vec2, 4> corner{b.lo, Vec2{b.hi.x, b.lo.y}, b.hi, Vec2{b.lo.x, b.hi.y}};
+    for (size_t e = 0; e < 4; ++e) {
+        if (!s.edge_ok[e]) continue;
+        for (const Vec2& c : corner)
+            if (orient(s.v[e], s.v[(e + 1) % 4], c) < 0) return false;
+    }
+    return true;
+}
+
+TEST_CASE("shaft: a box said to be inside is inside, and boxes clearly inside are said so") {
+    std::mt19937_64 rng(13);
+    std::uniform_real_distribution<double> u(-1, 1);
+    for (const auto& [scale, offset] : {std::pair{1.0, Vec2{0, 0}}, std::pair{1e-3, Vec2{3, -2}},
+                                        std::pair{1.0, Vec2{1e6, -3e5}}, std::pair{1.0, Vec2{1e14, -3e13}}}) {
+        long inside = 0, across = 0;
+        for (int t = 0; t < 400; ++t) {
+            const Pair pr = random_pair(rng, scale, offset);
+            const Shaft s(pr.i, pr.j);
+            for (int k = 0; k < 50; ++k) {
+                const Box b = random_box(rng, scale, offset, 0.8, 0.2);
+                const Shaft::Where w = s.where(b);
+                CHECK((w == Shaft::Where::outside) == !s.overlaps(b));
+                if (w == Shaft::Where::inside) {
+                    CHECK(inside_oracle(s, b));  // surely inside
+                    ++inside;
+                } else if (w == Shaft::Where::across) {
+                    ++across;
+                }
+            }
+        }
+        // Near the origin most of these boxes lie well inside the shaft;
+        // at 1e14 the margin is of the scene's size and nothing need be.
+        if (std::abs(offset.x) < 1e10) CHECK(inside > 2000);
+        CHECK(inside + across > 2000);
     }
 }
 
