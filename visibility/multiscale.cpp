@@ -841,16 +841,7 @@ MultiscaleResult MultiscaleVisibility::form_factor_skipping(const Segment& i, co
         static_assert(long_shaft_layers >= opaque_band_count * band_slab_layers, "the slabs fit in a long shaft");
         if (std::isfinite(depth) && depth * m_layers_per_depth >= long_shaft_layers) {
             const double slab = band_slab_layers / m_layers_per_depth, half = 0.5 * slab;
-            const auto lateral = [&](Vec2 p) { return dot(p - g.origin, rot90(g.u)); };
-            const auto side_at = [&](double t, Vec2 p, Vec2 q) {  // the side p -> q at depth t
-                const double tp = at_depth(p), tq = at_depth(q);
-                return lateral(p) + (t - tp) / (tq - tp) * (lateral(q) - lateral(p));
-            };
-            // The sides A1 -> C0 and C1 -> A0 (opaque_band.cpp).
-            const auto width_at = [&](double t) {
-                return std::abs(side_at(t, g.ci.b, g.cj.a) - side_at(t, g.cj.b, g.ci.a));
-            };
-            const bool from_i = width_at(xi) <= width_at(xj);
+            const bool from_i = narrower_at_i(g.ci, g.cj);
             double t0[opaque_band_count], slab_lo[opaque_band_count], slab_hi[opaque_band_count];
             for (int k = 0; k < opaque_band_count; ++k) {
                 t0[k] = from_i ? xi + (k + 0.5) * slab : xj - (k + 0.5) * slab;  // the bands' depths

@@ -125,6 +125,13 @@ double band_free(const Band& band, double c, double h, double bar, OpaqueBandScr
 
 }  // namespace
 
+bool narrower_at_i(const Segment& ci, const Segment& cj) {
+    const shaft_detail::PairFrame frame(ci, cj);
+    const Vec2 A0 = frame.local(ci.a), A1 = frame.local(ci.b), C0 = frame.local(cj.a), C1 = frame.local(cj.b);
+    const auto width_at = [&](double t) { return std::abs(y_at(t, A1, C0) - y_at(t, C1, A0)); };
+    return width_at(std::max(A0.x, A1.x)) <= width_at(std::min(C0.x, C1.x));
+}
+
 double band_bound(const Segment& ci, const Segment& cj, const Segment* blockers, size_t count,
                   const BandOptions& options, OpaqueBandScratch& ws) {
     const double limit = options.limit;

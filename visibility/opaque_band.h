@@ -140,6 +140,10 @@ inline double band_depth(int k, double xi, double xj) {
     return xi + (xj - xi) * (slot + 0.5) / opaque_band_count;
 }
 
+/// Whether the shaft of ci and cj (as band_bound takes them) is no wider
+/// across its axis at ci's end than at cj's: where bands need fewest pieces.
+bool narrower_at_i(const Segment& ci, const Segment& cj);
+
 /// An upper bound on L_i F_ij, the exchange of ci and cj (a mutually
 /// clipped facing pair lit on the left) through the blockers (whole
 /// segments: each is clipped here to the depths between the patches), from

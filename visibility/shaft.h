@@ -29,8 +29,6 @@ inline constexpr double on_edge_tolerance = 1e-13;
 // so this errs wide.
 inline constexpr double event_slack = 1e-9;
 
-// The shaft: the convex hull of the clipped pair, A0 A1 C0 C1 counter-clockwise
-// (i = A0 -> A1 and j = C0 -> C1 both lit on the left and facing each other).
 // A culling test may err towards "overlaps" (a node visited for nothing,
 // a piece clipped to nothing), never the other way. Its plain products (no
 // FMA) are within ~6e-16 of |n|_1 (|c| + |r| + |h|) of the exact value (n
@@ -40,6 +38,8 @@ inline constexpr double event_slack = 1e-9;
 // below any real gap.
 inline constexpr double culling_slack = 1e-13;
 
+// The shaft: the convex hull of the clipped pair, A0 A1 C0 C1 counter-clockwise
+// (i = A0 -> A1 and j = C0 -> C1 both lit on the left and facing each other).
 struct Shaft {
     std::array<Vec2, 4> v;        // A0, A1, C0, C1
     std::array<bool, 4> edge_ok;  // false for a zero-length side (shared endpoint)
