@@ -56,10 +56,12 @@ private:
     fs::path m_path;
 };
 
-// A closed room crowded with two-sided plates: with --subdivide 20 the
-// exact solve has 1680 elements, 1.4 million occluded pairs: tens of
-// seconds even in Release, so a signal sent after half a second always
-// finds it computing.
+// A closed room crowded with two-sided plates: with --subdivide 60 the
+// exact solve has 5040 elements. Its dense LU alone is 2/3 n^3 = 8.5e10
+// flops on one thread (4.0 s in Release, 2026-12-02; the form factors
+// another 2.0 s), a floor that faster visibility cannot lower, so a signal
+// sent after half a second always finds it computing. (--subdivide 20 took
+// 0.49 s once the exact visibility got fast, and the signal came too late.)
 std::string crowded_room() {
     std::string surfaces =
         R"({"name": "room", "material": "white", "points": [[0, 0], [10, 0], [10, 10], [0, 10]], "closed": true, "side": "in"})";
@@ -109,7 +111,7 @@ void interrupt_solve(int sig) {
 
     const pid_t child = fork_child([&] {
         std::ostringstream out, err;
-        return flatrad::run_cli({"solve", scene.string(), "-o", result.string(), "--method", "exact", "--subdivide", "20",
+        return flatrad::run_cli({"solve", scene.string(), "-o", result.string(), "--method", "exact", "--subdivide", "60",
                                  "--threads", "1", "-q"},
                                 out, err);
     });
