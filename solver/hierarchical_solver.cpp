@@ -4,6 +4,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cstddef>
 #include <cmath>
@@ -34,6 +35,7 @@
 #include "solver/sink_visibility.h"
 #include "solver/table_array.h"
 #include "solver/uninitialized_allocator.h"
+#include "visibility/closure_screen.h"
 #include "visibility/cluster_tables.h"
 #include "visibility/exact_visibility.h"
 #include "visibility/multiscale.h"
@@ -90,6 +92,30 @@ constexpr size_t min_pieces_to_bound = 32;
 // the 10^4 forest 11.2 -> 8.8 s at eps 1, the 10^5 forest 102 -> 65 s at
 // eps 10 (README).
 constexpr size_t min_pieces_to_prove_closed = 32;
+
+// Closure screens (visibility/closure_screen.h, behind_closure_screen): an
+// element's screens lie in closure_screen_bins directions (absolute angles,
+// bins of 1.875 degrees), each at closure_screen_depth times the depth
+// from which a shaft is long (MultiscaleVisibility::long_shaft_depth: the
+// proof then walks only the slabs near the element), reaching
+// closure_screen_spread times its depth to each side (the bin's half-width
+// is 0.016 of it; the rest is room for the targets' own width and the
+// element's). One screen per element and bin, asked for by the first target
+// behind it and shown closed or not once: the answer for a target depends
+// only on the element and the target, not on which thread asked first.
+// Measured on the 10^5 forest at eps 10 (`scripts/make-scene 100000 --seed
+// 1 --density 30`; cluster visits, slab proofs and links answered by
+// screens, one run each): none 359 M / 211 007 / 0; 16 bins, 0.41 (wide
+// screens) 359 M / 211 007 / 0 (no screen shown closed: across a wide
+// section a band nearly always leaves a gap); 64, 0.1 345 M / 192 444 / 18 859
+// (element-to-cluster links only); then with element links too: 64, 0.05
+// 328 M / 172 310 / 39 218; 128, 0.035 317 M; 128, 0.05 308 M / 147 966 /
+// 64 056; 128, 0.08 332 M; 192, 0.04 303 M / 142 318 / 70 172; 192, 0.05
+// 310 M; 256, 0.025 320 M; 256, 0.035 303 M. Proving the screens took
+// about 0.4 s of the run's ~40 thread-seconds of visibility (128, 0.05).
+constexpr int closure_screen_bins = 192;
+constexpr double closure_screen_depth = 1.05;
+constexpr double closure_screen_spread = 0.04;
 
 // GMRES stops at ||E - (I - rho G) B|| <= 1e-12 ||E||: the operator is
 // applied in double with sums of at most a few thousand terms per node, so
@@ -383,6 +409,7 @@ public:
         m_vis.set_min_pieces_to_approximate(min_pieces_to_approximate);
         m_vis.set_min_pieces_to_bound(min_pieces_to_bound);
         m_vis.set_min_pieces_to_prove_closed(min_pieces_to_prove_closed);  // (after set_blockers: see there)
+        if (o.closure_screens) m_screen_depth = closure_screen_depth * m_vis.long_shaft_depth();
         m_unblockable = std::find(blockers.begin(), blockers.end(), 1) == blockers.end();
         m_kappa = m_vis.layers_per_depth();
         if (m_opt.emission_first && !m_unblockable && m_hierarchy.root() >= 0) {
@@ -457,6 +484,8 @@ private:
     bool resolve_visibility(Link& l, ExactWorkspace& ws, VisibilityStats& st) const;
     double kernel_variation(const Node& r, const Node& s, double Fu) const;
     std::pair<double, double> link_transmittance(int r, int s, ExactWorkspace& ws, VisibilityStats& st) const;
+    bool behind_closure_screen(int e, const Box& region, ExactWorkspace& ws, VisibilityStats& st) const;
+    Box cluster_target_region(int hnode) const;
     void compute_links(LinkVector& links);
     int split_element(int node);
     void pull_tables(const double* leaf_value, std::vector<double>& Bn, TableArray& I,
@@ -509,6 +538,13 @@ private:
     // (symmetric: the lines joining the two cross-sections).
     mutable std::unordered_map<uint64_t, std::pair<double, double>> m_tau_cache;
     mutable std::shared_mutex m_tau_mutex;
+    // Closure screens (behind_closure_screen): per element node, per
+    // direction bin, 0 not asked yet, 1 shown closed, 2 not shown closed or
+    // not possible there. m_screen_depth: where they stand (infinite: none
+    // are made).
+    mutable std::unordered_map<int, std::array<int8_t, closure_screen_bins>> m_screens;
+    mutable std::shared_mutex m_screen_mutex;
+    double m_screen_depth = std::numeric_limits<double>::infinity();
     // Per hierarchy node: the node whose segments a transmittance from it
     // does not count as blockers (itself, or its highest ancestor made of
     // the same convex closed loop: see convex_object_skips).
@@ -1262,6 +1298,19 @@ bool HierarchicalSolver::resolve_visibility(Link& l, ExactWorkspace& ws, Visibil
     const Node& ns = m_nodes[static_cast<size_t>(l.s)];
     l.vis_pending = false;
     if (!nr.cluster() && !ns.cluster()) {
+        // Behind a closure screen of either end: closed. The region holds
+        // the other end's whole segment (the query does not count it as a
+        // blocker; the screen's proof did not count the one end's).
+        auto segment_box = [&](const Node& n) {
+            Box b;
+            b.add(m_scene.segments[static_cast<size_t>(n.segment)].seg);
+            return b;
+        };
+        if (behind_closure_screen(l.s, segment_box(nr), ws, st) || behind_closure_screen(l.r, segment_box(ns), ws, st)) {
+            ++st.screened;
+            l.coef = 0;
+            return false;
+        }
         const double Fu = form_factor_unoccluded(nr.seg, ns.seg);  // (make_link's)
         const MultiscaleResult m = m_vis.form_factor(nr.seg, ns.seg, nr.segment, ns.segment, m_vis_eps,
                                                      GammaRule::Bound, ws, st);
@@ -1338,9 +1387,64 @@ std::pair<double, double> HierarchicalSolver::link_transmittance(int r, int s, E
         if (const auto whole = lookup(key_of(root)))
             if (whole->second == 0 && (whole->first == 0 || whole->first >= 1 - 1e-12)) return *whole;
     return cached(key_of(e), [&] {
+        if (behind_closure_screen(e, cluster_target_region(other.hnode), ws, st)) {
+            ++st.screened;
+            return TransmittanceResult{};  // closed, exactly
+        }
         return m_vis.transmittance(ne.seg, skip(ne.hnode), other.hnode, skip(other.hnode), m_vis_eps, GammaRule::Bound,
                                    ws, st);
     });
+}
+
+// The region a closure screen must cover for a link to hierarchy node h:
+// the square around h's box centre circumscribing the circle through its
+// corners (every stand-in of h lies in that circle: multiscale.cpp's
+// node_stand_in, a cross-section through the centre no wider than the
+// box's diagonal), with the box of h's skipped node (its segments are not
+// blockers for the link, so none may stand on the near side of the
+// screen).
+Box HierarchicalSolver::cluster_target_region(int h) const {
+    const Box& box = m_hierarchy.node(h).box;
+    const Vec2 c = box.center();
+    const double r = 0.5 * box.diagonal();
+    Box region;
+    region.add(c - Vec2{r, r});
+    region.add(c + Vec2{r, r});
+    region.add(m_hierarchy.node(m_tau_skip[static_cast<size_t>(h)]).box);
+    return region;
+}
+
+// Whether a closure screen of element e (visibility/closure_screen.h) shows
+// every line from e to `region` blocked (region: every point the link's
+// lines may reach, and every segment the link does not count as a
+// blocker). The screen: e's own, in the direction bin of the region's
+// centre (closure_screen_bins), made and proven on first use. A region the
+// screen does not cover (too near, or too wide for it) is left to the
+// link's own query.
+bool HierarchicalSolver::behind_closure_screen(int e, const Box& region, ExactWorkspace& ws,
+                                               VisibilityStats& st) const {
+    const Node& ne = m_nodes[static_cast<size_t>(e)];
+    if (ne.kind != Kind::Element || !std::isfinite(m_screen_depth) || region.empty()) return false;
+    const Vec2 m = ne.seg.midpoint(), c = region.center();
+    // The region's nearest point to m is nearer than the screen: no use.
+    const Vec2 near{std::clamp(m.x, region.lo.x, region.hi.x), std::clamp(m.y, region.lo.y, region.hi.y)};
+    if (!(distance(near, m) > m_screen_depth)) return false;
+    const double bin = 2 * std::numbers::pi / closure_screen_bins;
+    const double angle = std::atan2(c.y - m.y, c.x - m.x);  // in [-pi, pi]
+    const int k = std::clamp(static_cast<int>(std::floor((angle + std::numbers::pi) / bin)), 0, closure_screen_bins - 1);
+    const double centre = -std::numbers::pi + (k + 0.5) * bin;
+    const auto screen = closure_screen(ne.seg, m + Vec2{std::cos(centre), std::sin(centre)}, m_screen_depth,
+                                       closure_screen_spread * m_screen_depth);
+    if (!screen || !screen_covers(*screen, ne.seg, region)) return false;
+    {
+        std::shared_lock lock(m_screen_mutex);
+        const auto it = m_screens.find(e);
+        if (it != m_screens.end() && it->second[static_cast<size_t>(k)] != 0) return it->second[static_cast<size_t>(k)] == 1;
+    }
+    const bool closed = m_vis.shown_closed(ne.seg, m_tau_skip[static_cast<size_t>(ne.hnode)], *screen, ws, st);
+    std::unique_lock lock(m_screen_mutex);
+    m_screens[e][static_cast<size_t>(k)] = closed ? 1 : 2;  // (another thread may have found the same)
+    return closed;
 }
 
 void HierarchicalSolver::compute_links(LinkVector& links) {

@@ -103,6 +103,18 @@
 ///    sender too dim for any transmittance to matter is never queried;
 ///    later rounds ask again against the new solution.
 ///    stats.unqueried_links counts the links the final solve carried so.
+///  - Closure screens (visibility/closure_screen.h): in a dense scene a
+///    bright element's links to clusters many layers of shadow away are
+///    nearly all closed, and each once cost its own proof. Now an element
+///    has, per direction bin, one screen beyond the depth from which a
+///    shaft is long (MultiscaleVisibility::long_shaft_depth), proven closed
+///    once from the slabs near the element (shown_closed); a link from it
+///    (to a cluster, or to an element: either end's screen) whose target
+///    lies wholly behind a closed screen that every line to it crosses is
+///    closed, exactly, with no query of its own. Made on first use, one
+///    per element and bin, so the answer depends only on the link, not on
+///    which thread asked first. stats.visibility.screens counts the screens
+///    shown closed, .screened the links they answered.
 ///  - Solve: per channel, the matrix-free operator on the element leaves:
 ///    pull (means up the element trees, exitance tables up the clusters),
 ///    gather along the links (in parallel over receivers), push (tables
@@ -168,6 +180,12 @@ struct HierarchicalOptions {
     /// Deferred visibility (see above); off: every link that survives its
     /// geometry asks the visibility module (for tests: the oracle).
     bool defer_visibility = true;
+    /// Closure screens (visibility/closure_screen.h): an element's links to
+    /// clusters far across a dense scene are first checked against screens
+    /// of that element shown closed once, each serving every target behind
+    /// it (see "Closure screens" above); off: every such link asks its own
+    /// query (for tests: the oracle).
+    bool closure_screens = true;
     /// Called now and then from the solving thread with what is being done
     /// ("refine pass 2", "solve", ...) and a fraction in [0, 1] of the whole
     /// run when one is known (< 0 otherwise). Empty: no reports. The CLI

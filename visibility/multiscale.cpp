@@ -734,13 +734,31 @@ std::optional<TransmittanceResult> MultiscaleVisibility::transmittance_between(c
     return out;
 }
 
+double MultiscaleVisibility::long_shaft_depth() const {
+    if (!(m_layers_per_depth > 0) || m_min_pieces_to_prove_closed == std::numeric_limits<size_t>::max())
+        return infinity;
+    return long_shaft_layers / m_layers_per_depth;
+}
+
+bool MultiscaleVisibility::shown_closed(const Segment& a, int skip_a, const Segment& t, ExactWorkspace& ws,
+                                        VisibilityStats& stats) const {
+    const ClusterNode& SA = m_hierarchy->node(skip_a);
+    const MultiscaleResult r =
+        form_factor_skipping(a, t, SkipRange{SA.first, SA.count}, SkipRange{}, 0, GammaRule::Bound, ws, stats, true);
+    const bool closed = r.F == 0 && r.error_bound == 0;
+    if (closed) ++stats.screens;
+    return closed;
+}
+
 MultiscaleResult MultiscaleVisibility::form_factor_skipping(const Segment& i, const Segment& j, SkipRange skip_a,
                                                             SkipRange skip_b, double eps, GammaRule rule,
-                                                            ExactWorkspace& ws, VisibilityStats& stats) const {
+                                                            ExactWorkspace& ws, VisibilityStats& stats,
+                                                            bool slabs_only) const {
     MultiscaleResult out;
     const PairGeometry g = pair_geometry(i, j);
     if (!g.visible) {
         ++stats.culled;
+        if (slabs_only) out.error_bound = infinity;  // not shown closed: nothing was asked
         return out;
     }
     const Shaft shaft(g.ci, g.cj);
@@ -839,7 +857,10 @@ MultiscaleResult MultiscaleVisibility::form_factor_skipping(const Segment& i, co
         const double xj = std::min(at_depth(g.cj.a), at_depth(g.cj.b));
         const double depth = xj - xi;
         static_assert(long_shaft_layers >= opaque_band_count * band_slab_layers, "the slabs fit in a long shaft");
-        if (std::isfinite(depth) && depth * m_layers_per_depth >= long_shaft_layers) {
+        // (A screen's proof, slabs_only, needs only room for the slabs: its
+        // depth is set by its maker, in the pair's frame it may be less.)
+        const double long_from = slabs_only ? opaque_band_count * band_slab_layers : long_shaft_layers;
+        if (std::isfinite(depth) && depth * m_layers_per_depth >= long_from) {
             const double slab = band_slab_layers / m_layers_per_depth, half = 0.5 * slab;
             const bool from_i = narrower_at_i(g.ci, g.cj);
             double t0[opaque_band_count], slab_lo[opaque_band_count], slab_hi[opaque_band_count];
@@ -883,6 +904,11 @@ MultiscaleResult MultiscaleVisibility::form_factor_skipping(const Segment& i, co
                 return out;
             }
         }
+    }
+    if (slabs_only) {
+        stats.clusters_visited += out.clusters_visited;
+        out.error_bound = infinity;  // not settled by the slabs
+        return out;
     }
 
     // 1a. Every blocker piece in the shaft, with its position in the

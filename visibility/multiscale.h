@@ -175,6 +175,22 @@ public:
     /// at a random angle shadows 2 L / pi of a line on average), set by
     /// set_min_pieces_to_prove_closed; 0 before, or with nothing to block.
     double layers_per_depth() const { return m_layers_per_depth; }
+    /// The depth from which a shaft is long (its slabs walked alone first,
+    /// see set_min_pieces_to_prove_closed): long_shaft_layers over
+    /// layers_per_depth; infinite while the density is unknown or the
+    /// proofs are off.
+    double long_shaft_depth() const;
+
+    /// Whether every line from segment a (lit on its left) to segment t
+    /// (facing a) is shown blocked by the hierarchy's blockers other than
+    /// those of hierarchy node skip_a: a proof from the slabs of a long
+    /// shaft alone (step 0 above), nothing else tried. False when the
+    /// proofs are off, the shaft is not long, or the slabs' bands leave a
+    /// gap. For closure screens (closure_screen.h): counted in
+    /// stats.queries and stats.slabs as any such proof, and in
+    /// stats.screens when shown closed.
+    bool shown_closed(const Segment& a, int skip_a, const Segment& t, ExactWorkspace& ws,
+                      VisibilityStats& stats) const;
 
 private:
     std::optional<TransmittanceResult> transmittance_between(const Segment& sa, const Segment& sb, int skip_a,
@@ -184,9 +200,11 @@ private:
     struct SkipRange {
         int32_t first = 0, count = 0;
     };
+    /// With slabs_only, step 0 alone: a query it does not settle (or that
+    /// is not long) returns an error bound of +infinity.
     MultiscaleResult form_factor_skipping(const Segment& i, const Segment& j, SkipRange skip_a, SkipRange skip_b,
-                                          double eps, GammaRule rule, ExactWorkspace& ws,
-                                          VisibilityStats& stats) const;
+                                          double eps, GammaRule rule, ExactWorkspace& ws, VisibilityStats& stats,
+                                          bool slabs_only = false) const;
 
     const Hierarchy* m_hierarchy;
     const ClusterTables* m_tables;

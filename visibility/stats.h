@@ -17,6 +17,8 @@ struct VisibilityStats {
     long opaque = 0;            ///< shafts shown closed by a band of pieces across them (opaque_band.h)
     long banded = 0;            ///< answered by bands' upper bound within the tolerance (opaque_band.h)
     long slabs = 0;             ///< of opaque and banded: settled by a long shaft's slabs alone (multiscale.h)
+    long screens = 0;           ///< closure screens shown closed (closure_screen.h, MultiscaleVisibility::shown_closed)
+    long screened = 0;          ///< queries answered by a closure screen instead (counted by the caller)
 
     VisibilityStats& operator+=(const VisibilityStats& o) {
         queries += o.queries;
@@ -32,6 +34,8 @@ struct VisibilityStats {
         opaque += o.opaque;
         banded += o.banded;
         slabs += o.slabs;
+        screens += o.screens;
+        screened += o.screened;
         return *this;
     }
 };

@@ -157,6 +157,8 @@ ordered_json visibility_stats_json(const VisibilityStats& s) {
     j["opaque"] = s.opaque;
     j["banded"] = s.banded;
     j["slabs"] = s.slabs;
+    j["screens"] = s.screens;
+    j["screened"] = s.screened;
     return j;
 }
 

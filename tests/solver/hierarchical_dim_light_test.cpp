@@ -19,58 +19,14 @@
 #include "engine/scene.h"
 #include "solver/exact_solver.h"
 #include "solver/hierarchical_solver.h"
+#include "support/forest_scene.h"
 #include "support/relative_l2.h"
 
 using namespace flatrad;
+using flatrad::test::forest_json;
 using flatrad::test::relative_l2;
 
 namespace {
-
-double point_segment(Vec2 p, const Segment& s) {
-    const Vec2 d = s.b - s.a;
-    const double t = std::clamp(dot(p - s.a, d) / norm_squared(d), 0.0, 1.0);
-    return distance(p, lerp(s.a, s.b, t));
-}
-
-// 0 where they cross, else the least distance from an end to the other.
-double segment_distance(const Segment& s, const Segment& q) {
-    const double o1 = orient(s.a, s.b, q.a), o2 = orient(s.a, s.b, q.b);
-    const double o3 = orient(q.a, q.b, s.a), o4 = orient(q.a, q.b, s.b);
-    if ((o1 > 0) != (o2 > 0) && (o3 > 0) != (o4 > 0)) return 0;
-    return std::min({point_segment(s.a, q), point_segment(s.b, q), point_segment(q.a, s), point_segment(q.b, s)});
-}
-
-// A square room of side `side` (reflectance 0.7, lit inside), a lamp under
-// the ceiling at [0.4, 0.6] of its width (emission 10, lit downwards) and
-// `sticks` two-sided sticks 0.05-0.15 long (reflectance 0.3) at random
-// positions and angles, none within 0.01 of another: the forests of
-// `scripts/make-scene N --density 30` in small.
-std::string forest_json(int sticks, double side, unsigned seed) {
-    std::mt19937_64 rng(seed);
-    std::uniform_real_distribution<double> U(0, 1);
-    std::vector<Segment> placed;
-    std::string surfaces = fmt::format(
-        R"({{"name": "room", "material": "wall", "closed": true, "side": "in", "points": [[0,0],[{0},0],[{0},{0}],[0,{0}]]}},)"
-        R"({{"name": "lamp", "material": "lamp", "side": "right", "points": [[{1},{2}],[{3},{2}]]}})",
-        side, 0.4 * side, side - 0.03, 0.6 * side);
-    const double margin = 0.1;
-    int tries = 0;
-    while (static_cast<int>(placed.size()) < sticks && ++tries < 1000000) {
-        const double len = 0.05 + 0.1 * U(rng), a = 2 * std::numbers::pi * U(rng);
-        const Vec2 c{margin + (side - 2 * margin) * U(rng), margin + (side - 2 * margin - 0.1) * U(rng)};
-        const Vec2 d{0.5 * len * std::cos(a), 0.5 * len * std::sin(a)};
-        const Segment s{c - d, c + d};
-        if (std::any_of(placed.begin(), placed.end(), [&](const Segment& q) { return segment_distance(s, q) < 0.01; }))
-            continue;
-        placed.push_back(s);
-        surfaces += fmt::format(R"(,{{"name": "t{}", "material": "tree", "side": "both", "points": [[{:.17g},{:.17g}],[{:.17g},{:.17g}]]}})",
-                                placed.size(), s.a.x, s.a.y, s.b.x, s.b.y);
-    }
-    REQUIRE(static_cast<int>(placed.size()) == sticks);
-    return R"({"flatrad": 1, "materials": {"wall": {"reflectance": 0.7}, "tree": {"reflectance": 0.3},
-        "lamp": {"reflectance": 0, "emission": 10}}, "surfaces": [)" + surfaces + "]}";
-}
-
 
 HierarchicalOptions oracle_options(double eps) {
     HierarchicalOptions o;
@@ -98,7 +54,7 @@ TEST_CASE("hierarchical dim light: a forest's dim links ask nothing, and the err
     // 5.8e-3 / 1.3e-2 / 1.0e-2 at eps 2 / 0.5 / 0.1; with the whole bar
     // 4.1e-2 at eps 2.
     constexpr double balance_slack = 5e-3;
-    const Scene scene = parse_scene(forest_json(300, 3.2, 7), "forest300.json");
+    const Scene scene = parse_scene(forest_json(300, 3.2, 3.2, 7), "forest300.json");
     const Solution exact = solve_exact(scene, {2, 0});
     for (double eps : {2.0, 0.5, 0.1}) {
         CAPTURE(eps);
