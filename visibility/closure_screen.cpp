@@ -72,20 +72,4 @@ bool screen_covers(const Segment& screen, const Segment& a, const Box& region) {
     return true;
 }
 
-bool screen_beyond(const Segment& screen, const Box& box) {
-    if (box.empty()) return false;
-    const Vec2 dir = screen.direction();
-    const double len2 = norm_squared(dir);
-    if (!(len2 > 0) || !std::isfinite(len2)) return false;
-    const Vec2 n = rot90(dir) / std::sqrt(len2);  // toward the segment it faces
-    const Vec2 corners[4] = {box.lo, {box.hi.x, box.lo.y}, box.hi, {box.lo.x, box.hi.y}};
-    double scale = std::max(magnitude(screen.a), magnitude(screen.b));
-    for (const Vec2& c : corners) scale = std::max(scale, magnitude(c));
-    if (!std::isfinite(scale)) return false;
-    const double margin = rounding_ulps * std::numeric_limits<double>::epsilon() * scale;
-    for (const Vec2& c : corners)
-        if (!(dot(c - screen.a, n) < -margin)) return false;
-    return true;
-}
-
 }  // namespace flatrad

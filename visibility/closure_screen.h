@@ -44,10 +44,4 @@ std::optional<Segment> closure_screen(const Segment& a, Vec2 toward, double dept
 /// 1e-9 of the screen's length at its ends) make every doubt a "no".
 bool screen_covers(const Segment& screen, const Segment& a, const Box& region);
 
-/// Whether `box` lies strictly behind the screen's line (the side away from
-/// the segment it faces), with the same margin of rounding: where the
-/// segments a query does not count as blockers must be, so that the
-/// screen's proof did not count them either.
-bool screen_beyond(const Segment& screen, const Box& box);
-
 }  // namespace flatrad

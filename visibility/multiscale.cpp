@@ -666,7 +666,7 @@ MultiscaleResult MultiscaleVisibility::form_factor(const Segment& i, const Segme
 // plate (relative L2 2.2e-2 against 6.7e-4), and it gained nothing on
 // data/default.json once elements are their own stand-ins and convex
 // objects do not block their own faces (solver/hierarchical_solver.cpp).
-Segment node_stand_in(const Hierarchy& h, const ClusterNode& n, Vec2 toward, bool cross_section) {
+static Segment node_stand_in(const Hierarchy& h, const ClusterNode& n, Vec2 toward, bool cross_section = false) {
     const Vec2 centre = n.box.center();
     const double d = distance(centre, toward);
     const Vec2 u = d > 0 ? (toward - centre) / d : Vec2{1, 0}, v = rot90(u);

@@ -98,13 +98,6 @@ struct TransmittanceResult {
     long clusters_approximated = 0;
 };
 
-/// The stand-in of hierarchy node n's contents toward the point `toward`
-/// (what transmittance() measures between): a lone segment itself (unless
-/// cross_section), else the cross-section through the box centre,
-/// perpendicular to the line from the centre to `toward`, as wide as the
-/// box seen along that line; oriented with its left side toward `toward`.
-Segment node_stand_in(const Hierarchy& h, const ClusterNode& n, Vec2 toward, bool cross_section = false);
-
 class MultiscaleVisibility {
 public:
     /// `tables` is built over `hierarchy`; both outlive this object.
