@@ -492,7 +492,7 @@ private:
     double kernel_variation(const Node& r, const Node& s, double Fu) const;
     std::pair<double, double> link_transmittance(int r, int s, ExactWorkspace& ws, VisibilityStats& st) const;
     bool behind_closure_screen(int e, const Box& region, ExactWorkspace& ws, VisibilityStats& st) const;
-    Box cluster_target_region(int hnode) const;
+    Box cluster_target_region(int hnode, Vec2 from) const;
     void compute_links(LinkVector& links);
     int split_element(int node);
     void pull_tables(const double* leaf_value, std::vector<double>& Bn, TableArray& I,
@@ -1394,7 +1394,7 @@ std::pair<double, double> HierarchicalSolver::link_transmittance(int r, int s, E
         if (const auto whole = lookup(key_of(root)))
             if (whole->second == 0 && (whole->first == 0 || whole->first >= 1 - 1e-12)) return *whole;
     return cached(key_of(e), [&] {
-        if (behind_closure_screen(e, cluster_target_region(other.hnode), ws, st)) {
+        if (behind_closure_screen(e, cluster_target_region(other.hnode, ne.seg.midpoint()), ws, st)) {
             ++st.screened;
             return TransmittanceResult{};  // closed, exactly
         }
@@ -1410,10 +1410,12 @@ std::pair<double, double> HierarchicalSolver::link_transmittance(int r, int s, E
 // box's diagonal), with the box of h's skipped node (its segments are not
 // blockers for the link, so none may stand on the near side of the
 // screen).
-Box HierarchicalSolver::cluster_target_region(int h) const {
+Box HierarchicalSolver::cluster_target_region(int h, Vec2 from) const {
     const Box& box = m_hierarchy.node(h).box;
     const Vec2 c = box.center();
-    const double r = 0.5 * box.diagonal();
+    // (node_stand_in keeps a cross-section at least 1e-12 of the distance
+    // wide: a box smaller than that still gets a circle holding it.)
+    const double r = std::max(0.5 * box.diagonal(), 2e-12 * distance(c, from));
     Box region;
     region.add(c - Vec2{r, r});
     region.add(c + Vec2{r, r});
