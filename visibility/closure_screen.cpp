@@ -1,6 +1,8 @@
 #include "visibility/closure_screen.h"
 
+#include <algorithm>
 #include <cmath>
+#include <initializer_list>
 #include <limits>
 
 namespace flatrad {
@@ -18,7 +20,15 @@ constexpr double rounding_ulps = 64;
 // any use here).
 constexpr double end_margin = 1e-9;
 
-double magnitude(Vec2 p) { return std::max(std::abs(p.x), std::abs(p.y)); }
+// The distance from a line below which a point counts as on it: rounding_ulps
+// ulps of the largest coordinate among `points` (infinite if any is not
+// finite, so that nothing passes).
+double rounding_margin(std::initializer_list<Vec2> points) {
+    double scale = 0;
+    for (const Vec2& p : points) scale = std::max({scale, std::abs(p.x), std::abs(p.y)});
+    return std::isfinite(scale) ? rounding_ulps * std::numeric_limits<double>::epsilon() * scale
+                                : std::numeric_limits<double>::infinity();
+}
 
 }  // namespace
 
@@ -30,8 +40,7 @@ std::optional<Segment> closure_screen(const Segment& a, Vec2 toward, double dept
     const Vec2 c = m + u * depth;
     // Left normal of [c - v h, c + v h] is rot90(v) = -u: toward a.
     const Segment t{c - v * half_width, c + v * half_width};
-    const double scale = std::max({magnitude(a.a), magnitude(a.b), magnitude(t.a), magnitude(t.b)});
-    const double margin = rounding_ulps * std::numeric_limits<double>::epsilon() * scale;
+    const double margin = rounding_margin({a.a, a.b, t.a, t.b});
     // t's ends strictly on a's lit side (orient is scaled by |a|).
     const Vec2 na = a.left_normal();
     if (!(dot(t.a - a.a, na) > margin && dot(t.b - a.a, na) > margin)) return std::nullopt;
@@ -47,10 +56,8 @@ bool screen_covers(const Segment& screen, const Segment& a, const Box& region) {
     if (!(len2 > 0) || !std::isfinite(len2)) return false;
     const Vec2 n = rot90(dir) / std::sqrt(len2);  // toward a
     const Vec2 corners[4] = {region.lo, {region.hi.x, region.lo.y}, region.hi, {region.lo.x, region.hi.y}};
-    double scale = std::max({magnitude(screen.a), magnitude(screen.b), magnitude(a.a), magnitude(a.b)});
-    for (const Vec2& c : corners) scale = std::max(scale, magnitude(c));
-    if (!std::isfinite(scale)) return false;
-    const double margin = rounding_ulps * std::numeric_limits<double>::epsilon() * scale;
+    const double margin = rounding_margin({screen.a, screen.b, a.a, a.b, corners[0], corners[1], corners[2], corners[3]});
+    if (!std::isfinite(margin)) return false;
     auto side = [&](Vec2 p) { return dot(p - screen.a, n); };  // > 0: a's side
     const Vec2 ends[2] = {a.a, a.b};
     double se[2];
