@@ -120,7 +120,9 @@
 ///    gather along the links (in parallel over receivers), push (tables
 ///    down the clusters, cosine lobes onto the sides, irradiance down the
 ///    elements); (I - rho G) B = E by restarted GMRES (solver/gmres.h) to
-///    1e-12. Independent sub-scenes (solver/light_parts.h: no link and no
+///    1e-12, the solves between refinement rounds (which only feed the
+///    next round's error estimates) to 1e-3 (1 - rho_max) and the last
+///    one on from there. Independent sub-scenes (solver/light_parts.h: no link and no
 ///    shared linked ancestor between them) are solved apart, each with its
 ///    own Krylov run on its own nodes; stats.independent_parts counts them,
 ///    stats.iterations the longest run's operator applications. The
@@ -186,6 +188,11 @@ struct HierarchicalOptions {
     /// it (see "Closure screens" above); off: every such link asks its own
     /// query (for tests: the oracle).
     bool closure_screens = true;
+    /// Solves between refinement rounds stop at a looser residual (see
+    /// "Solve" above); off: every solve to the full 1e-12 (for tests: the
+    /// same links whichever way the operator is split into parts, as the
+    /// loose solves of parts apart and together stop at different points).
+    bool loose_intermediate_solves = true;
     /// Called now and then from the solving thread with what is being done
     /// ("refine pass 2", "solve", ...) and a fraction in [0, 1] of the whole
     /// run when one is known (< 0 otherwise). Empty: no reports. The CLI
