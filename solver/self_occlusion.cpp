@@ -12,17 +12,36 @@ namespace {
 // Exactly, for few segments: per facing side, its interval across u minus
 // the overlaps with blockers in front of it (segments that do not cross:
 // which of two is in front is the same all over their overlap, so its
-// midpoint decides). O(n^2) per direction.
+// midpoint decides). O(n^2) per direction, both directions of a line at
+// once: bins k and k + K/2 look along u and -u, where each pair's overlap
+// is the same and the front one along u is the back one along -u.
 void visible_fraction_exact(const Segment* segs, const uint8_t* sides, size_t n, double out[directional_bins]) {
+    static_assert(directional_bins % 2 == 0, "bin k + K/2 looks along -u");
+    constexpr int half = directional_bins / 2;
     struct Proj {
         double lo, hi, dlo, dhi;
-        bool facing, blocker;
+        bool facing[2];  // along u, along -u
+        bool blocker;
     };
     thread_local std::vector<Proj> pr;
-    thread_local std::vector<std::pair<double, double>> hidden;
+    thread_local std::vector<std::pair<double, double>> hidden[2];
     pr.resize(n);
     const auto& dirs = bin_directions();
-    for (int k = 0; k < directional_bins; ++k) {
+    auto depth_at = [](const Proj& q, double p) {
+        return q.hi > q.lo ? q.dlo + (p - q.lo) / (q.hi - q.lo) * (q.dhi - q.dlo) : std::max(q.dlo, q.dhi);
+    };
+    // The length of [lo, hi] not covered by the intervals in h (sorted here).
+    auto uncovered = [](double lo, double hi, std::vector<std::pair<double, double>>& h) {
+        std::sort(h.begin(), h.end());
+        double at = lo, covered = 0;
+        for (const auto& [a, b] : h) {
+            if (b <= at) continue;
+            covered += b - std::max(a, at);
+            at = b;
+        }
+        return hi - lo - covered;
+    };
+    for (int k = 0; k < half; ++k) {
         const Vec2 u = dirs[static_cast<size_t>(k)];
         const Vec2 v{-u.y, u.x};
         for (size_t i = 0; i < n; ++i) {
@@ -33,37 +52,36 @@ void visible_fraction_exact(const Segment* segs, const uint8_t* sides, size_t n,
                 std::swap(da, db);
             }
             const double c = dot(s.left_normal(), u);
-            const uint8_t side = c > 0 ? left_side : c < 0 ? right_side : 0;
-            pr[i] = {pa, pb, da, db, (sides[i] & side) != 0, (sides[i] & blocks) != 0};
+            const uint8_t along = c > 0 ? left_side : c < 0 ? right_side : 0;
+            const uint8_t against = c > 0 ? right_side : c < 0 ? left_side : 0;
+            pr[i] = {pa, pb, da, db, {(sides[i] & along) != 0, (sides[i] & against) != 0}, (sides[i] & blocks) != 0};
         }
-        auto depth_at = [](const Proj& q, double p) {
-            return q.hi > q.lo ? q.dlo + (p - q.lo) / (q.hi - q.lo) * (q.dhi - q.dlo) : std::max(q.dlo, q.dhi);
-        };
-        double seen = 0, all = 0;
+        double seen[2] = {0, 0}, all[2] = {0, 0};
         for (size_t i = 0; i < n; ++i) {
             const Proj& a = pr[i];
-            if (!a.facing || !(a.hi > a.lo)) continue;
-            all += a.hi - a.lo;
-            hidden.clear();
+            if ((!a.facing[0] && !a.facing[1]) || !(a.hi > a.lo)) continue;
+            hidden[0].clear();
+            hidden[1].clear();
             for (size_t j = 0; j < n; ++j) {
                 const Proj& b = pr[j];
                 if (j == i || !b.blocker) continue;
                 const double lo = std::max(a.lo, b.lo), hi = std::min(a.hi, b.hi);
                 if (!(hi > lo)) continue;
                 const double mid = 0.5 * (lo + hi);
-                if (depth_at(b, mid) > depth_at(a, mid)) hidden.emplace_back(lo, hi);
+                const double db = depth_at(b, mid), da = depth_at(a, mid);
+                if (a.facing[0] && db > da) hidden[0].emplace_back(lo, hi);  // in front along u
+                if (a.facing[1] && db < da) hidden[1].emplace_back(lo, hi);  // in front along -u
             }
-            std::sort(hidden.begin(), hidden.end());
-            double at = a.lo, covered = 0;
-            for (const auto& [lo, hi] : hidden) {
-                if (hi <= at) continue;
-                covered += hi - std::max(lo, at);
-                at = hi;
-            }
-            seen += a.hi - a.lo - covered;
+            for (int w = 0; w < 2; ++w)
+                if (a.facing[w]) {
+                    all[w] += a.hi - a.lo;
+                    seen[w] += uncovered(a.lo, a.hi, hidden[w]);
+                }
         }
-        const double share = seen / all;
-        if (all > 0 && std::isfinite(share)) out[k] = std::clamp(share, 0.0, 1.0);  // else unmeasured: 1
+        for (int w = 0; w < 2; ++w) {
+            const double share = seen[w] / all[w];
+            if (all[w] > 0 && std::isfinite(share)) out[k + w * half] = std::clamp(share, 0.0, 1.0);  // else unmeasured: 1
+        }
     }
 }
 
