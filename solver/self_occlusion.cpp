@@ -93,78 +93,105 @@ void visible_fraction(const Segment* segs, const uint8_t* sides, size_t n, doubl
     if (lines == 0 && n <= exact_up_to) return visible_fraction_exact(segs, sides, n, out);
     const int M = lines > 0 ? lines : static_cast<int>(std::clamp<size_t>(2 * n, 64, 1024));
     const size_t Ms = static_cast<size_t>(M);
-    // Per line: the frontmost blocker's depth and whether its side facing u
-    // exists; how many existing sides facing u the line meets; how many of
-    // those belong to segments that cannot block and lie in front.
-    thread_local std::vector<double> depth;
-    thread_local std::vector<uint8_t> front;
-    thread_local std::vector<int32_t> count, passive;
-    depth.resize(Ms);
-    front.resize(Ms);
-    count.resize(Ms);
-    passive.resize(Ms);
+    // Bins k and k + K/2 look along u and -u: the same lines across, each
+    // segment meeting the same ones at the same depths, the frontmost
+    // blocker along -u being the hindmost along u. Both are measured in one
+    // pass over the segments, w = 0 along u, w = 1 along -u.
+    // Per line and way: the frontmost blocker's depth and whether its side
+    // facing that way exists; how many existing sides facing that way the
+    // line meets; how many of those belong to segments that cannot block
+    // and lie in front.
+    constexpr int half = directional_bins / 2;
+    thread_local std::vector<double> depth[2];
+    thread_local std::vector<uint8_t> front[2];
+    thread_local std::vector<int32_t> count[2], passive[2];
+    for (int w = 0; w < 2; ++w) {
+        depth[w].resize(Ms);
+        front[w].resize(Ms);
+        count[w].resize(Ms);
+        passive[w].resize(Ms);
+    }
     const auto& dirs = bin_directions();
-    for (int k = 0; k < directional_bins; ++k) {
+    constexpr double inf = std::numeric_limits<double>::infinity();
+    for (int k = 0; k < half; ++k) {
         const Vec2 u = dirs[static_cast<size_t>(k)];
         const Vec2 v{-u.y, u.x};  // across the lines
-        double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+        double lo = inf, hi = -inf;
         for (size_t i = 0; i < n; ++i) {
             const double pa = dot(segs[i].a, v), pb = dot(segs[i].b, v);
             lo = std::min({lo, pa, pb});
             hi = std::max({hi, pa, pb});
         }
-        const double w = (hi - lo) / M;
+        const double wl = (hi - lo) / M;
         // Every segment along u (nothing faces it), or an extent past the
         // largest double (coordinates near 1e308): left at 1, unmeasured.
-        if (!(w > 0) || !std::isfinite(w)) continue;
-        std::fill(depth.begin(), depth.end(), -std::numeric_limits<double>::infinity());
-        std::fill(front.begin(), front.end(), uint8_t{0});
-        std::fill(count.begin(), count.end(), 0);
-        std::fill(passive.begin(), passive.end(), 0);
-        // Blockers first (the depth buffer), then the segments that cannot
+        if (!(wl > 0) || !std::isfinite(wl)) continue;
+        // Depths along u; along -u the frontmost is the least of them.
+        std::fill(depth[0].begin(), depth[0].end(), -inf);
+        std::fill(depth[1].begin(), depth[1].end(), inf);
+        for (int w = 0; w < 2; ++w) {
+            std::fill(front[w].begin(), front[w].end(), uint8_t{0});
+            std::fill(count[w].begin(), count[w].end(), 0);
+            std::fill(passive[w].begin(), passive[w].end(), 0);
+        }
+        // Blockers first (the depth buffers), then the segments that cannot
         // block: seen where in front of the frontmost blocker.
         for (int pass = 0; pass < 2; ++pass) {
             for (size_t i = 0; i < n; ++i) {
                 const bool blocker = (sides[i] & blocks) != 0;
                 if (blocker != (pass == 0)) continue;
                 const Segment& s = segs[i];
-                // The side facing u, if it exists (a segment along u faces
-                // nothing and covers a line's centre only by rounding).
+                // The sides facing u and -u, if they exist (a segment along
+                // u faces nothing and covers a line's centre only by
+                // rounding).
                 const double c = dot(s.left_normal(), u);
-                const uint8_t side = c > 0 ? left_side : c < 0 ? right_side : 0;
-                const bool facing = (sides[i] & side) != 0;
-                if (!blocker && !facing) continue;
+                const uint8_t along = c > 0 ? left_side : c < 0 ? right_side : 0;
+                const uint8_t against = c > 0 ? right_side : c < 0 ? left_side : 0;
+                const bool facing[2] = {(sides[i] & along) != 0, (sides[i] & against) != 0};
+                if (!blocker && !facing[0] && !facing[1]) continue;
                 double pa = dot(s.a, v), pb = dot(s.b, v), da = dot(s.a, u), db = dot(s.b, u);
                 if (pa > pb) {
                     std::swap(pa, pb);
                     std::swap(da, db);
                 }
-                // Lines j, at lo + (j + 1/2) w, within [pa, pb].
-                const int j0 = std::max(0, static_cast<int>(std::ceil((pa - lo) / w - 0.5)));
-                const int j1 = std::min(M - 1, static_cast<int>(std::floor((pb - lo) / w - 0.5)));
+                // Lines j, at lo + (j + 1/2) wl, within [pa, pb].
+                const int j0 = std::max(0, static_cast<int>(std::ceil((pa - lo) / wl - 0.5)));
+                const int j1 = std::min(M - 1, static_cast<int>(std::floor((pb - lo) / wl - 0.5)));
+                // The depth at line j: linear in j (a segment across no
+                // width, at most one line: its middle).
                 const double span = pb - pa;
+                const double slope = span > 0 ? (db - da) / span : 0.0;
+                const double d_lo = span > 0 ? da + (lo + 0.5 * wl - pa) * slope : 0.5 * (da + db);
+                const double d_step = wl * slope;
                 for (int j = j0; j <= j1; ++j) {
                     const size_t js = static_cast<size_t>(j);
-                    const double t = span > 0 ? (lo + (j + 0.5) * w - pa) / span : 0.5;
-                    const double d = da + t * (db - da);
-                    if (facing) ++count[js];
+                    const double d = d_lo + j * d_step;
+                    count[0][js] += facing[0];
+                    count[1][js] += facing[1];
                     if (pass == 0) {
-                        if (d > depth[js]) {
-                            depth[js] = d;
-                            front[js] = facing ? 1 : 0;
+                        if (d > depth[0][js]) {
+                            depth[0][js] = d;
+                            front[0][js] = facing[0];
                         }
-                    } else if (d >= depth[js]) {
-                        ++passive[js];
+                        if (d < depth[1][js]) {
+                            depth[1][js] = d;
+                            front[1][js] = facing[1];
+                        }
+                    } else {
+                        passive[0][js] += facing[0] && d >= depth[0][js];
+                        passive[1][js] += facing[1] && d <= depth[1][js];
                     }
                 }
             }
         }
-        long seen = 0, all = 0;
-        for (size_t j = 0; j < Ms; ++j) {
-            seen += front[j] + passive[j];
-            all += count[j];
+        for (int w = 0; w < 2; ++w) {
+            long seen = 0, all = 0;
+            for (size_t j = 0; j < Ms; ++j) {
+                seen += front[w][j] + passive[w][j];
+                all += count[w][j];
+            }
+            if (all > 0) out[k + w * half] = static_cast<double>(seen) / static_cast<double>(all);
         }
-        if (all > 0) out[k] = static_cast<double>(seen) / static_cast<double>(all);
     }
 }
 
