@@ -33,8 +33,8 @@ double y_at(double t, Vec2 p, Vec2 q) { return p.y + (t - p.x) / (q.x - p.x) * (
 // narrowed by it (what it shadows at every direction of the bin). Stops
 // once the free length exceeds `budget` (and returns what it has, >
 // budget). Anything not finite gives +infinity.
-double uncovered(const Band& band, int s, double c, double h, const size_t* items, size_t count, double budget,
-                 OpaqueBandScratch& ws) {
+double uncovered(const Band& band, int s, double c, double h, const size_t* items, const double* radius,
+                 size_t count, double budget, OpaqueBandScratch& ws) {
     const double nx = -std::sin(c), ny = std::cos(c);
     const Vec2* P = ws.points.data() + band.head + section_head * static_cast<size_t>(s);
     const double* R = ws.radius.data() + band.head + section_head * static_cast<size_t>(s);
@@ -61,7 +61,7 @@ double uncovered(const Band& band, int s, double c, double h, const size_t* item
     const Vec2* ends = ws.run_ends.data() + band.ends_first;  // items: positions in the band's run
     for (size_t it = 0; it < count; ++it) {
         const Vec2 p = ends[2 * items[it]] - O, q = ends[2 * items[it] + 1] - O;
-        const Interval sh = held(nx * p.x + ny * p.y, norm(p) * h, nx * q.x + ny * q.y, norm(q) * h);
+        const Interval sh = held(nx * p.x + ny * p.y, radius[2 * it] * h, nx * q.x + ny * q.y, radius[2 * it + 1] * h);
         if (sh.b > sh.a && sh.b > window.a && sh.a < window.b) shadows.push_back(sh);
     }
     std::sort(shadows.begin(), shadows.end(), [](const Interval& x, const Interval& y) { return x.a < y.a; });
@@ -79,29 +79,40 @@ double uncovered(const Band& band, int s, double c, double h, const size_t* item
     return free + (window.b - reach);
 }
 
-// The band's free length at every direction of [c - h, c + h], summed over
-// its sections; more than `bar` (and so stopped early, the sum unfinished)
-// when it exceeds bar.
-double band_free(const Band& band, double c, double h, double bar, OpaqueBandScratch& ws) {
-    // Each piece goes to the sections its offsets at c can reach (a filter
-    // only: a piece left out of a section only leaves more free). About the
-    // band's corner (t0, ya) a point (t0, y) of X is at cos(c) (y - ya), so
-    // section s spans [s, s + 1] cos(c) w, widened by its ends' drift w h / 2;
-    // a piece's shadow at c lies between its ends' offsets, and its held
-    // shadow within that.
-    const double nx = -std::sin(c), ny = std::cos(c), span = ny * band.w, pad = 0.5 * band.w * h;
+// Buckets band k's pieces by section for every direction of [c_lo, c_hi]
+// (a group of consecutive bins of half-width h), a filter only: a piece
+// left out of a section only leaves more free, one put in needlessly
+// costs a look. About X's midpoint (t0, ym) a point (t0, y) of X is at
+// cos(c) (y - ym) at direction c, so section s spans [s - S/2, s + 1 -
+// S/2] cos(c) w, widened by its ends' drift w h / 2 within a bin; a
+// piece's shadow at c lies between its ends' offsets n(c) . (P - M) (its
+// held shadow within that), each within |P - M| |c - cm| of its value at
+// the group's middle direction cm (a rotation by c - cm moves a
+// projection by at most the vector's length times the angle), and cos(c)
+// lies between its least and largest over the group.
+void bucket_band(const Band& band, OpaqueBandScratch::Buckets& bb, double c_lo, double c_hi, double h,
+                 OpaqueBandScratch& ws) {
+    const double cm = 0.5 * (c_lo + c_hi), hr = 0.5 * (c_hi - c_lo);
+    const double nx = -std::sin(cm), ny = std::cos(cm), pad = 0.5 * band.w * h;
+    const double cos_least = std::min(std::cos(c_lo), std::cos(c_hi));
+    const double cos_most = c_lo <= 0 && c_hi >= 0 ? 1.0 : std::max(std::cos(c_lo), std::cos(c_hi));
+    const double span_lo = cos_least * band.w, span_hi = cos_most * band.w;
     const int S = band.sections;
-    auto& first_of = ws.bucket_first;
-    auto& items = ws.bucket_items;
+    const Vec2 M{band.t0, band.ya + 0.5 * S * band.w};
+    auto& first_of = bb.first;
+    auto& items = bb.items;
     auto& range = ws.bucket_range;
     first_of.assign(static_cast<size_t>(S) + 1, 0);
     range.resize(band.last - band.first);
     // (The band's ends in run order: build_band; items are run positions.)
     const Vec2* end = ws.run_ends.data() + band.ends_first;
     for (size_t r = band.first; r < band.last; ++r, end += 2) {
-        const double pp = nx * (end[0].x - band.t0) + ny * (end[0].y - band.ya);
-        const double pq = nx * (end[1].x - band.t0) + ny * (end[1].y - band.ya);
-        const double lo = std::floor((std::min(pp, pq) - pad) / span), hi = std::floor((std::max(pp, pq) + pad) / span);
+        const Vec2 p = end[0] - M, q = end[1] - M;
+        const double pp = nx * p.x + ny * p.y, pq = nx * q.x + ny * q.y;
+        const double turn = std::max(norm(p), norm(q)) * hr;
+        const double L = std::min(pp, pq) - turn - pad, H = std::max(pp, pq) + turn + pad;
+        const double lo = std::floor(std::min(L / span_lo, L / span_hi) + 0.5 * S);
+        const double hi = std::floor(std::max(H / span_lo, H / span_hi) + 0.5 * S);
         const int a = static_cast<int>(std::clamp(lo, 0.0, static_cast<double>(S)));
         const int b = static_cast<int>(std::clamp(hi, -1.0, S - 1.0));
         range[r - band.first] = {a, b};
@@ -111,14 +122,54 @@ double band_free(const Band& band, double c, double h, double bar, OpaqueBandScr
     items.resize(first_of[static_cast<size_t>(S)]);
     auto& fill = ws.bucket_fill;
     fill.assign(first_of.begin(), first_of.end() - 1);
+    bb.radius.resize(2 * items.size());
+    const Vec2* ends = ws.run_ends.data() + band.ends_first;
     for (size_t r = band.first; r < band.last; ++r) {
         const auto [a, b] = range[r - band.first];
-        for (int sct = a; sct <= b; ++sct) items[fill[static_cast<size_t>(sct)]++] = r - band.first;
+        const size_t item = r - band.first;
+        for (int sct = a; sct <= b; ++sct) {
+            const size_t at = fill[static_cast<size_t>(sct)]++;
+            items[at] = item;
+            const Vec2 O{band.t0, band.ya + (sct + 0.5) * band.w};  // as uncovered's
+            bb.radius[2 * at] = norm(ends[2 * item] - O);
+            bb.radius[2 * at + 1] = norm(ends[2 * item + 1] - O);
+        }
     }
+}
+
+// Bins per bucketing of band k: as many as keep each piece's turn within
+// the group (|P - M| times half the group's angle) under half a section's
+// width, so that a piece lands in about one section more than at a single
+// direction. (Bucketing every bin anew was a third of band_bound's time on
+// the 10^5 forest, where the bins of a long shaft's proof barely turn.)
+int bucket_group_size(const Band& band, double h, int bins, const OpaqueBandScratch& ws) {
+    const Vec2 M{band.t0, band.ya + 0.5 * band.sections * band.w};
+    double reach = 0;
+    const Vec2* end = ws.run_ends.data() + band.ends_first;
+    for (size_t r = band.first; r < band.last; ++r, end += 2)
+        reach = std::max({reach, norm(end[0] - M), norm(end[1] - M)});
+    const double g = std::floor(0.5 * band.w / (reach * h));
+    return std::isfinite(g) ? static_cast<int>(std::clamp(g, 1.0, static_cast<double>(bins))) : (g > 0 ? bins : 1);
+}
+
+// The band's free length at every direction of bin b ([c - h, c + h], of
+// `bins` over [-delta, delta]), summed over its sections; more than `bar`
+// (and so stopped early, the sum unfinished) when it exceeds bar.
+double band_free(const Band& band, OpaqueBandScratch::Buckets& bb, int b, int bins, double delta, double h,
+                 double bar, OpaqueBandScratch& ws) {
+    if (bb.group_size == 0) bb.group_size = bucket_group_size(band, h, bins, ws);
+    const int group = b / bb.group_size;
+    if (bb.group != group) {
+        const int b0 = group * bb.group_size, b1 = std::min(bins, b0 + bb.group_size);
+        bucket_band(band, bb, -delta + 2 * b0 * h, -delta + 2 * b1 * h, h, ws);
+        bb.group = group;
+    }
+    const double c = -delta + (2 * b + 1) * h;
+    const int S = band.sections;
     double sum = 0;
     for (int sct = 0; sct < S && sum <= bar; ++sct) {
-        const size_t f = first_of[static_cast<size_t>(sct)], l = first_of[static_cast<size_t>(sct) + 1];
-        sum += uncovered(band, sct, c, h, items.data() + f, l - f, bar - sum, ws);
+        const size_t f = bb.first[static_cast<size_t>(sct)], l = bb.first[static_cast<size_t>(sct) + 1];
+        sum += uncovered(band, sct, c, h, bb.items.data() + f, bb.radius.data() + 2 * f, l - f, bar - sum, ws);
     }
     return sum;
 }
@@ -283,14 +334,17 @@ double band_bound(const Segment& ci, const Segment& cj, const Segment* blockers,
     const int bins = static_cast<int>(bins_wanted);
     const double h = delta / bins;
     double total = 0;  // the sum over bins of h times the bin's free length
+    for (auto& bb : ws.buckets) {
+        bb.group = -1;  // none made for these bands yet
+        bb.group_size = 0;
+    }
     for (int b = 0; b < bins; ++b) {
-        const double c = -delta + (2 * b + 1) * h;
         const double allowance = (limit - total) / h;  // the most this bin may leave free
         double best = not_shown;
         for (int k = 0; k < opaque_band_count && best > 0; ++k) {
             if (k == static_cast<int>(bands.size()) && !(build_band(k) > 0)) break;  // no piece
             const double bar = std::min(best, allowance);
-            const double sum = band_free(bands[static_cast<size_t>(k)], c, h, bar, ws);
+            const double sum = band_free(bands[static_cast<size_t>(k)], ws.buckets[static_cast<size_t>(k)], b, bins, delta, h, bar, ws);
             if (sum <= bar) best = sum;  // finished, and the least so far
         }
         if (!(best <= allowance)) return not_shown;

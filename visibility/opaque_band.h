@@ -70,13 +70,26 @@ struct OpaqueBandScratch {
     std::vector<Band> bands;
     std::vector<Vec2> points;
     std::vector<double> radius;
-    std::vector<size_t> bucket_first, bucket_fill, bucket_items;  // one bin's pieces by section
+    /// A band's pieces by section, for a group of consecutive bins
+    /// (band_bound's bins loop): items[first[s], first[s + 1]) are section
+    /// s's (positions in the band's run), radius[2 i], radius[2 i + 1]
+    /// item i's ends' distances to section s's midpoint.
+    struct Buckets {
+        std::vector<size_t> first, items;
+        std::vector<double> radius;  // per item, its ends' distances to its section's midpoint
+        int group = -1;       // the group they are for (-1: none yet)
+        int group_size = 0;   // bins per group (0: not chosen yet)
+    };
+    Buckets buckets[3];  // per band (opaque_band_count)
+    std::vector<size_t> bucket_fill;
     std::vector<std::pair<int, int>> bucket_range;
     std::vector<Interval> shadows;
 };
 
 /// Bands tried, at depths evenly spaced between the patches.
 inline constexpr int opaque_band_count = 3;
+static_assert(sizeof(OpaqueBandScratch::buckets) / sizeof(OpaqueBandScratch::Buckets) == opaque_band_count,
+              "one bucketing per band");
 /// Pieces in a band: those nearest to its depth until the lengths of their
 /// shadows across the pair's axis add up to this many times the section X
 /// (a dense forest's band then covers X with room for the drift), or
