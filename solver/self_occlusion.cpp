@@ -9,6 +9,19 @@ namespace flatrad {
 
 namespace {
 
+// Which of segment s's existing sides (`has`, self_occlusion.h's bits)
+// face u and -u: [0] along u, [1] along -u (a segment along u faces
+// neither).
+struct Facing {
+    bool way[2];
+};
+Facing facing_ways(const Segment& s, uint8_t has, Vec2 u) {
+    const double c = dot(s.left_normal(), u);
+    const uint8_t along = c > 0 ? left_side : c < 0 ? right_side : 0;
+    const uint8_t against = c > 0 ? right_side : c < 0 ? left_side : 0;
+    return {{(has & along) != 0, (has & against) != 0}};
+}
+
 // Exactly, for few segments: per facing side, its interval across u minus
 // the overlaps with blockers in front of it (segments that do not cross:
 // which of two is in front is the same all over their overlap, so its
@@ -51,10 +64,8 @@ void visible_fraction_exact(const Segment* segs, const uint8_t* sides, size_t n,
                 std::swap(pa, pb);
                 std::swap(da, db);
             }
-            const double c = dot(s.left_normal(), u);
-            const uint8_t along = c > 0 ? left_side : c < 0 ? right_side : 0;
-            const uint8_t against = c > 0 ? right_side : c < 0 ? left_side : 0;
-            pr[i] = {pa, pb, da, db, {(sides[i] & along) != 0, (sides[i] & against) != 0}, (sides[i] & blocks) != 0};
+            const Facing f = facing_ways(s, sides[i], u);
+            pr[i] = {pa, pb, da, db, {f.way[0], f.way[1]}, (sides[i] & blocks) != 0};
         }
         double seen[2] = {0, 0}, all[2] = {0, 0};
         for (size_t i = 0; i < n; ++i) {
@@ -144,10 +155,8 @@ void visible_fraction(const Segment* segs, const uint8_t* sides, size_t n, doubl
                 // The sides facing u and -u, if they exist (a segment along
                 // u faces nothing and covers a line's centre only by
                 // rounding).
-                const double c = dot(s.left_normal(), u);
-                const uint8_t along = c > 0 ? left_side : c < 0 ? right_side : 0;
-                const uint8_t against = c > 0 ? right_side : c < 0 ? left_side : 0;
-                const bool facing[2] = {(sides[i] & along) != 0, (sides[i] & against) != 0};
+                const Facing f = facing_ways(s, sides[i], u);
+                const bool* facing = f.way;
                 if (!blocker && !facing[0] && !facing[1]) continue;
                 double pa = dot(s.a, v), pb = dot(s.b, v), da = dot(s.a, u), db = dot(s.b, u);
                 if (pa > pb) {
