@@ -1871,7 +1871,14 @@ bool HierarchicalSolver::refine(const std::vector<double>& leaf_bmax, double exi
             VisibilityStats local;
             long asked = 0;
             bool above = false;
-#pragma omp for schedule(dynamic, 64)
+            // Small chunks: a wave's queries cluster (the children of one
+            // split link sit side by side, often all in one crowded shaft),
+            // and late waves hold a few hundred links, a few dozen of them
+            // queries of 0.1-0.2 ms. With chunks of 64 one thread took most
+            // of them while the other waited: the 1000-segment forest at eps
+            // 5 took 0.104 / 0.118 / 0.104 s (medians of 11) against 0.094 /
+            // 0.098 / 0.099 s with chunks of 4 (1: the same as 4).
+#pragma omp for schedule(dynamic, 4)
             for (long k = 0; k < nw; ++k) {
                 Link& l = m_links[tail + static_cast<size_t>(k)];
                 const Node& r = m_nodes[static_cast<size_t>(l.r)];
