@@ -52,6 +52,7 @@
 #include "engine/formfactor.h"
 #include "engine/geometry.h"
 #include "engine/scene.h"
+#include "large_pages.h"
 #include "solver/exact_solver.h"
 #include "solver/hierarchical_solver.h"
 #include "visibility/exact_visibility.h"
@@ -1361,6 +1362,7 @@ int run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
+    flatrad::use_large_pages();  // as the flatrad program (versus runs the solvers in-process)
     try {
         return run(argc, argv);
     } catch (const UsageError& e) {

@@ -2,5 +2,9 @@
 #include <iostream>
 
 #include "cli/cli.h"
+#include "large_pages.h"
 
-int main(int argc, char** argv) { return flatrad::run_cli(argc, argv, std::cout, std::cerr); }
+int main(int argc, char** argv) {
+    flatrad::use_large_pages();
+    return flatrad::run_cli(argc, argv, std::cout, std::cerr);
+}

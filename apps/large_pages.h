@@ -1,0 +1,37 @@
+#pragma once
+// The flatrad programs' allocator (CMakeLists.txt, FLATRAD_MIMALLOC; README,
+// "Dependencies"): where the build links mimalloc, its memory comes in large
+// OS pages (2 MiB transparent huge pages, on Linux through madvise), which
+// spares the solver's large arrays most of their page faults and TLB misses:
+// a round room of 10^6 walls solved in 9-11 s instead of 15 s on 2 cores.
+// Only the programs do this; a program embedding the library keeps its own
+// allocator (with glibc it can get huge pages from GLIBC_TUNABLES=
+// glibc.malloc.hugetlb=1).
+#include <cstdlib>
+
+#if FLATRAD_WITH_MIMALLOC
+#include <mimalloc.h>
+#endif
+
+namespace flatrad {
+
+/// Whether this program's malloc is mimalloc (FLATRAD_WITH_MIMALLOC).
+inline constexpr bool built_with_mimalloc =
+#if FLATRAD_WITH_MIMALLOC
+    true;
+#else
+    false;
+#endif
+
+/// First thing in main(): mimalloc takes large OS pages from then on, unless
+/// the environment says otherwise (MIMALLOC_LARGE_OS_PAGES=0 turns them
+/// off). (mimalloc reads its options from the environment as the process
+/// starts, so a new default would come too late: the option is set only
+/// when the environment leaves it unset.) Without mimalloc, nothing.
+inline void use_large_pages() {
+#if FLATRAD_WITH_MIMALLOC
+    if (!std::getenv("MIMALLOC_LARGE_OS_PAGES")) mi_option_enable(mi_option_large_os_pages);
+#endif
+}
+
+}  // namespace flatrad
