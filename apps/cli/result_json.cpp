@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdlib>
+#include <future>
 #include <string_view>
 #include <vector>
 
@@ -226,41 +227,71 @@ std::string result_text(const Scene& scene, const Solution& solution) {
     // The names once each, escaped as the DOM would.
     std::vector<std::string> names(scene.surfaces.size());
     for (size_t k = 0; k < names.size(); ++k) names[k] = compact(ordered_json(scene.surfaces[k].name));
-    size_t elements = 0;
-    for (const PatchResult& r : solution.patches) elements += r.elements.size();
-    text.reserve(text.size() + 200 * scene.patches.size() + 80 * elements);
-    for (size_t p = 0; p < scene.patches.size(); ++p) {
-        const Patch& patch = scene.patches[p];
-        const SceneSegment& seg = scene.segments[static_cast<std::size_t>(patch.segment)];
-        const PatchResult& r = solution.patches.at(p);
-        text += p == 0 ? "\n    {\"surface\":" : ",\n    {\"surface\":";
-        text += names[static_cast<size_t>(patch.surface)];
-        text += ",\"segment\":";
-        text += std::to_string(seg.index);
-        text += ",\"side\":\"";
-        text += side_name(patch.side);
-        text += "\",\"a\":";
-        append_point(text, seg.seg.a);
-        text += ",\"b\":";
-        append_point(text, seg.seg.b);
-        text += ",\"length\":";
-        append_number(text, patch.length);
-        text += ",\"radiosity\":";
-        append_array(text, r.radiosity);
-        text += ",\"elements\":[";
-        for (size_t i = 0; i < r.elements.size(); ++i) {
-            const ElementValue& e = r.elements[i];
-            text += i == 0 ? "[" : ",[";
-            append_number(text, e.t0);
-            text += ',';
-            append_number(text, e.t1);
-            for (double b : e.B) {
-                text += ',';
-                append_number(text, b);
+    // Room for the lines of patches p0 to p1 (a patch's line is under 200
+    // bytes and an element's under 80 but for extreme numbers).
+    auto room = [&](size_t p0, size_t p1) {
+        size_t elements = 0;
+        for (size_t p = p0; p < p1; ++p) elements += solution.patches.at(p).elements.size();
+        return 200 * (p1 - p0) + 80 * elements;
+    };
+    // Appends the patches' lines from patch p0 to p1 (each led by its
+    // separator) to out.
+    auto patch_lines = [&](size_t p0, size_t p1, std::string& out) {
+        for (size_t p = p0; p < p1; ++p) {
+            const Patch& patch = scene.patches[p];
+            const SceneSegment& seg = scene.segments[static_cast<std::size_t>(patch.segment)];
+            const PatchResult& r = solution.patches.at(p);
+            out += p == 0 ? "\n    {\"surface\":" : ",\n    {\"surface\":";
+            out += names[static_cast<size_t>(patch.surface)];
+            out += ",\"segment\":";
+            out += std::to_string(seg.index);
+            out += ",\"side\":\"";
+            out += side_name(patch.side);
+            out += "\",\"a\":";
+            append_point(out, seg.seg.a);
+            out += ",\"b\":";
+            append_point(out, seg.seg.b);
+            out += ",\"length\":";
+            append_number(out, patch.length);
+            out += ",\"radiosity\":";
+            append_array(out, r.radiosity);
+            out += ",\"elements\":[";
+            for (size_t i = 0; i < r.elements.size(); ++i) {
+                const ElementValue& e = r.elements[i];
+                out += i == 0 ? "[" : ",[";
+                append_number(out, e.t0);
+                out += ',';
+                append_number(out, e.t1);
+                for (double b : e.B) {
+                    out += ',';
+                    append_number(out, b);
+                }
+                out += ']';
             }
-            text += ']';
+            out += "]}";
         }
-        text += "]}";
+    };
+    // A large result in two halves, the second on another thread (each
+    // number's shortest digits are most of the work), appended to the
+    // first: the same text either way. The first half is written in place,
+    // with room for the second, so that only the second half's pages are
+    // new (fresh pages are slow to come by on some machines). A round room
+    // of 10^6 walls, four alternating runs: 0.72-0.75 s against 1.06-1.10 s
+    // on one thread; both halves written apart and then joined had been no
+    // faster than one thread (0.71-0.76 s against 0.63-0.68 s).
+    const size_t n = scene.patches.size();
+    text.reserve(text.size() + room(0, n) + 4096);
+    if (n >= parallel_result_patches) {
+        std::future<std::string> second = std::async(std::launch::async, [&] {
+            std::string out;
+            out.reserve(room(n / 2, n));
+            patch_lines(n / 2, n, out);
+            return out;
+        });
+        patch_lines(0, n / 2, text);
+        text += second.get();
+    } else {
+        patch_lines(0, n, text);
     }
     text += scene.patches.empty() ? "]" : "\n  ]";
     for (auto it = tail.begin(); it != tail.end(); ++it)

@@ -34,7 +34,11 @@ std::string format_result(const nlohmann::ordered_json& result);
 /// (at 10^6 patches the DOM took 3.5 s and ~1 GB; this ~0.5 s). Doubles
 /// get the shortest digits that read back to them (std::to_chars), where
 /// nlohmann's grisu2 sometimes prints a 17th: the values are the same bits,
-/// the text may be a digit shorter.
+/// the text may be a digit shorter. From parallel_result_patches patches
+/// on, the second half of the patches is written on a second thread.
 std::string result_text(const Scene& scene, const Solution& solution);
+
+/// Patches from which result_text writes in two halves at once.
+inline constexpr size_t parallel_result_patches = 1 << 15;
 
 }  // namespace flatrad

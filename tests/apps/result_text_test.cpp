@@ -76,3 +76,38 @@ TEST_CASE("result_text: numbers of every form, names that need escaping, no patc
     none.patches.clear();
     CHECK(same_result(result_text(empty, none), format_result(result_json(empty, none))));
 }
+
+TEST_CASE("result_text: a result large enough to be written in two halves says what the DOM says") {
+    // A polyline of parallel_result_patches + 3 walls (an odd count: the
+    // halves differ by one), lit on both sides, with made-up values: no
+    // solve is needed to check the writing.
+    const size_t walls = parallel_result_patches + 3;
+    std::string points;
+    for (size_t k = 0; k <= walls; ++k) {
+        if (k > 0) points += ',';
+        points += '[';
+        points += std::to_string(k);
+        points += ',';
+        points += std::to_string((k * 7919) % 13);
+        points += ']';
+    }
+    const Scene scene = parse_scene(R"({"flatrad": 1, "name": "halves", "materials": {"w": {"reflectance": 0.5}},
+        "surfaces": [{"name": "wall", "material": "w", "points": [)" + points + R"(], "side": "both"}]})",
+                                    "halves.json");
+    REQUIRE(scene.patches.size() >= parallel_result_patches);
+    Solution sol;
+    sol.method = "hierarchical";
+    sol.channels = 1;
+    sol.patches.resize(scene.patches.size());
+    for (size_t p = 0; p < sol.patches.size(); ++p) {
+        const double b = 1.0 / static_cast<double>(p + 3);
+        sol.patches[p].radiosity = {b};
+        for (size_t e = 0; e <= p % 3; ++e)
+            sol.patches[p].elements.push_back({static_cast<double>(e) / 3, static_cast<double>(e + 1) / 3, {b * (e + 1)}});
+    }
+    sol.totals.add_channel(1.0, 0.75, 0.25);
+    const std::string text = result_text(scene, sol);
+    // The same value and the same lines: no patch lost or doubled at the
+    // join between the halves, the separators right on both sides of it.
+    CHECK(same_result(text, format_result(result_json(scene, sol))));
+}
