@@ -3,7 +3,7 @@
 // "Dependencies"): where the build links mimalloc, its memory comes in large
 // OS pages (2 MiB transparent huge pages, on Linux through madvise), which
 // spares the solver's large arrays most of their page faults and TLB misses:
-// a round room of 10^6 walls solved in 9-11 s instead of 15 s on 2 cores.
+// a round room of 10^6 walls solved in 8.7-10.6 s instead of 14.8-15.5 s.
 // Only the programs do this; a program embedding the library keeps its own
 // allocator (with glibc it can get huge pages from GLIBC_TUNABLES=
 // glibc.malloc.hugetlb=1).
