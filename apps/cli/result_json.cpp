@@ -1,5 +1,6 @@
 #include "cli/result_json.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstddef>
@@ -227,12 +228,18 @@ std::string result_text(const Scene& scene, const Solution& solution) {
     // The names once each, escaped as the DOM would.
     std::vector<std::string> names(scene.surfaces.size());
     for (size_t k = 0; k < names.size(); ++k) names[k] = compact(ordered_json(scene.surfaces[k].name));
-    // Room for the lines of patches p0 to p1 (a patch's line is under 200
-    // bytes and an element's under 80 but for extreme numbers).
+    // Room for the lines of patches p0 to p1: per patch its surface's name,
+    // the keys and five numbers (at most 24 bytes each) and a radiosity per
+    // channel; per element two numbers and one per channel.
+    const size_t channels = static_cast<size_t>(std::max(solution.channels, 1));
     auto room = [&](size_t p0, size_t p1) {
-        size_t elements = 0;
-        for (size_t p = p0; p < p1; ++p) elements += solution.patches.at(p).elements.size();
-        return 200 * (p1 - p0) + 80 * elements;
+        size_t bytes = 0;
+        for (size_t p = p0; p < p1; ++p) {
+            const PatchResult& r = solution.patches.at(p);
+            bytes += names[static_cast<size_t>(scene.patches[p].surface)].size() + 80 + 24 * (5 + channels) +
+                     r.elements.size() * (8 + 24 * (2 + channels));
+        }
+        return bytes;
     };
     // Appends the patches' lines from patch p0 to p1 (each led by its
     // separator) to out.

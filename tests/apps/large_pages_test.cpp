@@ -7,15 +7,19 @@
 
 #include <cstdlib>
 #include <memory>
+#include <string>
 
 #include "large_pages.h"
 
 #if FLATRAD_WITH_MIMALLOC
 TEST_CASE("the programs' operator new and malloc are mimalloc's, with large OS pages") {
     static_assert(flatrad::built_with_mimalloc);
-    const bool env_set = std::getenv("MIMALLOC_LARGE_OS_PAGES") != nullptr;
+    const bool env_set = flatrad::large_pages_set_by_environment();
     flatrad::use_large_pages();
     if (!env_set) CHECK(mi_option_is_enabled(mi_option_large_os_pages));
+    // The environment's word stands (MIMALLOC_LARGE_OS_PAGES=0: none).
+    const char* off = std::getenv("MIMALLOC_LARGE_OS_PAGES");
+    if (off && std::string(off) == "0") CHECK_FALSE(mi_option_is_enabled(mi_option_large_os_pages));
     // The override is in effect (a link order that left glibc's malloc
     // first would fail these): small and large blocks, through new and
     // through malloc, come from mimalloc's heap.

@@ -78,9 +78,9 @@ TEST_CASE("result_text: numbers of every form, names that need escaping, no patc
 }
 
 TEST_CASE("result_text: a result large enough to be written in two halves says what the DOM says") {
-    // A polyline of parallel_result_patches + 3 walls (an odd count: the
-    // halves differ by one), lit on both sides, with made-up values: no
-    // solve is needed to check the writing.
+    // A polyline of parallel_result_patches + 3 walls lit on one side (an
+    // odd count of patches: the halves differ by one), with made-up values:
+    // no solve is needed to check the writing.
     const size_t walls = parallel_result_patches + 3;
     std::string points;
     for (size_t k = 0; k <= walls; ++k) {
@@ -92,9 +92,10 @@ TEST_CASE("result_text: a result large enough to be written in two halves says w
         points += ']';
     }
     const Scene scene = parse_scene(R"({"flatrad": 1, "name": "halves", "materials": {"w": {"reflectance": 0.5}},
-        "surfaces": [{"name": "wall", "material": "w", "points": [)" + points + R"(], "side": "both"}]})",
+        "surfaces": [{"name": "wall", "material": "w", "points": [)" + points + R"(], "side": "left"}]})",
                                     "halves.json");
     REQUIRE(scene.patches.size() >= parallel_result_patches);
+    REQUIRE(scene.patches.size() % 2 == 1);
     Solution sol;
     sol.method = "hierarchical";
     sol.channels = 1;
