@@ -16,14 +16,6 @@
 
 namespace flatrad {
 
-/// Whether this program's malloc is mimalloc (FLATRAD_WITH_MIMALLOC).
-inline constexpr bool built_with_mimalloc =
-#if FLATRAD_WITH_MIMALLOC
-    true;
-#else
-    false;
-#endif
-
 /// Whether the environment sets mimalloc's large-pages option (mimalloc
 /// reads its variables in either case).
 inline bool large_pages_set_by_environment() {

@@ -13,7 +13,6 @@
 
 #if FLATRAD_WITH_MIMALLOC
 TEST_CASE("the programs' operator new and malloc are mimalloc's, with large OS pages") {
-    static_assert(flatrad::built_with_mimalloc);
     const bool env_set = flatrad::large_pages_set_by_environment();
     flatrad::use_large_pages();
     if (!env_set) CHECK(mi_option_is_enabled(mi_option_large_os_pages));
