@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <span>
 
 #include "visibility/shaft.h"
 
@@ -33,9 +34,9 @@ double y_at(double t, Vec2 p, Vec2 q) { return p.y + (t - p.x) / (q.x - p.x) * (
 // narrowed by it (what it shadows at every direction of the bin). Stops
 // once the free length exceeds `budget` (and returns what it has, >
 // budget). Anything not finite gives +infinity.
-double uncovered(const Band& band, int s, double c, double h, const size_t* items, const double* radius,
+double uncovered(const Band& band, int s, Vec2 n, double h, const size_t* items, const double* radius,
                  size_t count, double budget, OpaqueBandScratch& ws) {
-    const double nx = -std::sin(c), ny = std::cos(c);
+    const double nx = n.x, ny = n.y;
     const Vec2* P = ws.points.data() + band.head + section_head * static_cast<size_t>(s);
     const double* R = ws.radius.data() + band.head + section_head * static_cast<size_t>(s);
     auto proj = [&](size_t k) { return nx * P[k].x + ny * P[k].y; };
@@ -57,18 +58,21 @@ double uncovered(const Band& band, int s, double c, double h, const size_t* item
     // The pieces' shadows, about the section's midpoint O.
     const Vec2 O{band.t0, band.ya + (s + 0.5) * band.w};
     auto& shadows = ws.shadows;
-    shadows.clear();
+    if (shadows.size() < count) shadows.resize(count);
+    Interval* kept = shadows.data();
+    size_t m = 0;
     const Vec2* ends = ws.run_ends.data() + band.ends_first;  // items: positions in the band's run
     for (size_t it = 0; it < count; ++it) {
         const Vec2 p = ends[2 * items[it]] - O, q = ends[2 * items[it] + 1] - O;
         const Interval sh = held(nx * p.x + ny * p.y, radius[2 * it] * h, nx * q.x + ny * q.y, radius[2 * it + 1] * h);
-        if (sh.b > sh.a && sh.b > window.a && sh.a < window.b) shadows.push_back(sh);
+        kept[m] = sh;
+        m += sh.b > sh.a && sh.b > window.a && sh.a < window.b;
     }
-    std::sort(shadows.begin(), shadows.end(), [](const Interval& x, const Interval& y) { return x.a < y.a; });
+    std::sort(kept, kept + m, [](const Interval& x, const Interval& y) { return x.a < y.a; });
     // The gaps between the shadows, summed (not the window less the covered
     // length: a covered window gives exactly 0).
     double reach = window.a, free = 0;
-    for (const Interval& sh : shadows) {
+    for (const Interval& sh : std::span<const Interval>(kept, m)) {
         if (sh.a > reach) {
             free += sh.a - reach;
             if (free > budget) return free;
@@ -109,7 +113,7 @@ void bucket_band(const Band& band, OpaqueBandScratch::Buckets& bb, double c_lo, 
     for (size_t r = band.first; r < band.last; ++r, end += 2) {
         const Vec2 p = end[0] - M, q = end[1] - M;
         const double pp = nx * p.x + ny * p.y, pq = nx * q.x + ny * q.y;
-        const double turn = std::max(norm(p), norm(q)) * hr;
+        const double turn = std::sqrt(std::max(norm_squared(p), norm_squared(q))) * hr;  // (the larger norm)
         const double L = std::min(pp, pq) - turn - pad, H = std::max(pp, pq) + turn + pad;
         const double lo = std::floor(std::min(L / span_lo, L / span_hi) + 0.5 * S);
         const double hi = std::floor(std::max(H / span_lo, H / span_hi) + 0.5 * S);
@@ -167,11 +171,12 @@ double band_free(const Band& band, OpaqueBandScratch::Buckets& bb, int b, int bi
         bb.group = group;
     }
     const double c = -delta + (2 * b + 1) * h;
+    const Vec2 n{-std::sin(c), std::cos(c)};  // the bin's centre direction's normal, for every section
     const int S = band.sections;
     double sum = 0;
     for (int sct = 0; sct < S && sum <= bar; ++sct) {
         const size_t f = bb.first[static_cast<size_t>(sct)], l = bb.first[static_cast<size_t>(sct) + 1];
-        sum += uncovered(band, sct, c, h, bb.items.data() + f, bb.radius.data() + 2 * f, l - f, bar - sum, ws);
+        sum += uncovered(band, sct, n, h, bb.items.data() + f, bb.radius.data() + 2 * f, l - f, bar - sum, ws);
     }
     return sum;
 }
@@ -240,15 +245,10 @@ double band_bound(const Segment& ci, const Segment& cj, const Segment* blockers,
     }
     // The pieces by the depth of their midpoints: a band is a run of them
     // around its depth.
-    auto& index = ws.index;
-    auto& mid = ws.mid;
-    index.resize(n);
-    mid.resize(n);
-    for (size_t q = 0; q < n; ++q) {
-        index[q] = q;
-        mid[q] = 0.5 * (local[2 * q].x + local[2 * q + 1].x);
-    }
-    std::sort(index.begin(), index.end(), [&](size_t a, size_t b) { return mid[a] < mid[b]; });
+    auto& by_depth = ws.by_depth;
+    by_depth.resize(n);
+    for (size_t q = 0; q < n; ++q) by_depth[q] = {0.5 * (local[2 * q].x + local[2 * q + 1].x), q};
+    std::sort(by_depth.begin(), by_depth.end(), [](const auto& a, const auto& b) { return a.mid < b.mid; });
 
     ws.points.clear();
     ws.radius.clear();
@@ -271,13 +271,13 @@ double band_bound(const Segment& ci, const Segment& cj, const Segment* blockers,
         // opaque_band_max_pieces).
         const double needed = opaque_band_layers * (yb - ya);
         size_t right = static_cast<size_t>(
-            std::lower_bound(index.begin(), index.end(), t0, [&](size_t q, double t) { return mid[q] < t; }) -
-            index.begin());
-        size_t left = right;                  // the run taken is index[left, right)
+            std::lower_bound(by_depth.begin(), by_depth.end(), t0, [](const auto& d, double t) { return d.mid < t; }) -
+            by_depth.begin());
+        size_t left = right;                  // the run taken is by_depth[left, right)
         double across = 0, before = 0, after = 0;  // before, after: the run's reach in depth
         while (across < needed && right - left < opaque_band_max_pieces && (left > 0 || right < n)) {
-            const bool take_left = right == n || (left > 0 && t0 - mid[index[left - 1]] < mid[index[right]] - t0);
-            const size_t q = take_left ? index[--left] : index[right++];
+            const bool take_left = right == n || (left > 0 && t0 - by_depth[left - 1].mid < by_depth[right].mid - t0);
+            const size_t q = take_left ? by_depth[--left].piece : by_depth[right++].piece;
             across += std::abs(local[2 * q + 1].y - local[2 * q].y);
             before = std::max({before, t0 - local[2 * q].x, t0 - local[2 * q + 1].x});
             after = std::max({after, local[2 * q].x - t0, local[2 * q + 1].x - t0});
@@ -288,7 +288,7 @@ double band_bound(const Segment& ci, const Segment& cj, const Segment* blockers,
         // sections: read in sequence there, bin after bin.
         const size_t ends_first = ws.run_ends.size();
         for (size_t r = left; r < right; ++r) {
-            const size_t q = index[r];
+            const size_t q = by_depth[r].piece;
             for (size_t end = 0; end < 2; ++end)
                 ws.run_ends.push_back(local[2 * q + end]);
         }

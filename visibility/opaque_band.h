@@ -53,7 +53,7 @@ namespace flatrad {
 /// Scratch memory of one thread.
 struct OpaqueBandScratch {
     using Interval = OffsetInterval;
-    /// A band: its pieces (index[first, last)), its section X at depth t0
+    /// A band: its pieces (by_depth[first, last)), its section X at depth t0
     /// from y = ya in `sections` of width w, and their head points (ends,
     /// side points, patch ends) from points[head], section_head a section;
     /// its pieces' ends, in run order, from run_ends[ends_first].
@@ -64,8 +64,12 @@ struct OpaqueBandScratch {
     };
     std::vector<Segment> blockers;  // for the caller: the blockers to pass
     std::vector<Vec2> local;        // the blockers' ends in the pair's frame, clipped to the slab
-    std::vector<double> mid;
-    std::vector<size_t> index;      // the pieces by depth
+    /// The pieces by the depth of their midpoints (sorted on depth alone).
+    struct Depth {
+        double mid;
+        size_t piece;
+    };
+    std::vector<Depth> by_depth;
     std::vector<Vec2> run_ends;     // the bands' pieces' ends, band after band (Band::ends_first)
     std::vector<Band> bands;
     std::vector<Vec2> points;
