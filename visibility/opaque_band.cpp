@@ -141,20 +141,31 @@ void bucket_band(const Band& band, OpaqueBandScratch::Buckets& bb, double c_lo, 
     }
 }
 
+// How far (in sections' widths) a piece may turn within one bucketing's
+// group of bins. Bucketing costs about as much per piece as a section's
+// check, and a wider turn puts a piece in a section or two more: replaying
+// the 15 495 band_bound calls of the 10^4 forest at eps 10 (one thread,
+// medians of 5, the same answers at every value) took 1.07 s at 0.5, 0.97
+// s at 1, 0.94 s at 2, 0.95 s at 3, 1.00 s at 4, 1.02 s with one
+// bucketing per call; the 952 calls of the 1000-segment forest at eps 5
+// 27 / 24 / 22 / 23 ms at 0.5 / 1 / 2 / 3.
+constexpr double bucket_group_turn = 2;
+
 // Bins per bucketing of band k: as many as keep each piece's turn within
-// the group (|P - M| times half the group's angle) under half a section's
-// width, so that a piece lands in about one section more than at a single
-// direction. (Bucketing every bin anew took a third of band_bound's samples
-// on the 10^5 forest, where the bins of a long shaft's proof barely turn;
-// once per group, with the ends' distances kept for uncovered: band_bound
-// 8.4% fewer instructions on a 3x10^4 forest at eps 10, the same answers.)
+// the group (|P - M| times half the group's angle) under bucket_group_turn
+// sections' widths, so that a piece lands in at most about that many
+// sections more than at a single direction. (Bucketing every bin anew took
+// a third of band_bound's samples on the 10^5 forest, where the bins of a
+// long shaft's proof barely turn; once per group, with the ends' distances
+// kept for uncovered: band_bound 8.4% fewer instructions on a 3x10^4 forest
+// at eps 10, the same answers.)
 int bucket_group_size(const Band& band, double h, int bins, const OpaqueBandScratch& ws) {
     const Vec2 M{band.t0, band.ya + 0.5 * band.sections * band.w};
     double reach = 0;
     const Vec2* end = ws.run_ends.data() + band.ends_first;
     for (size_t r = band.first; r < band.last; ++r, end += 2)
         reach = std::max({reach, norm(end[0] - M), norm(end[1] - M)});
-    const double g = std::floor(0.5 * band.w / (reach * h));
+    const double g = std::floor(bucket_group_turn * band.w / (reach * h));
     return std::isfinite(g) ? static_cast<int>(std::clamp(g, 1.0, static_cast<double>(bins))) : (g > 0 ? bins : 1);
 }
 
