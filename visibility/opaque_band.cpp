@@ -34,8 +34,8 @@ double y_at(double t, Vec2 p, Vec2 q) { return p.y + (t - p.x) / (q.x - p.x) * (
 // narrowed by it (what it shadows at every direction of the bin). Stops
 // once the free length exceeds `budget` (and returns what it has, >
 // budget). Anything not finite gives +infinity.
-double uncovered(const Band& band, int s, Vec2 n, double h, const size_t* items, const double* radius,
-                 size_t count, double budget, OpaqueBandScratch& ws) {
+double uncovered(const Band& band, int s, Vec2 n, double h, const OpaqueBandScratch::Item* items, size_t count,
+                 double budget, OpaqueBandScratch& ws) {
     const double nx = n.x, ny = n.y;
     const Vec2* P = ws.points.data() + band.head + section_head * static_cast<size_t>(s);
     const double* R = ws.radius.data() + band.head + section_head * static_cast<size_t>(s);
@@ -55,16 +55,15 @@ double uncovered(const Band& band, int s, Vec2 n, double h, const size_t* items,
         window = {std::max(window.a, patch.a), std::min(window.b, patch.b)};
     }
     if (!(window.b > window.a)) return window.b <= window.a ? 0 : not_shown;  // no line to stop, or not finite
-    // The pieces' shadows, about the section's midpoint O.
-    const Vec2 O{band.t0, band.ya + (s + 0.5) * band.w};
+    // The pieces' shadows, about the section's midpoint (bucket_band made
+    // the items' ends relative to it).
     auto& shadows = ws.shadows;
     if (shadows.size() < count) shadows.resize(count);
     Interval* kept = shadows.data();
     size_t m = 0;
-    const Vec2* ends = ws.run_ends.data() + band.ends_first;  // items: positions in the band's run
     for (size_t it = 0; it < count; ++it) {
-        const Vec2 p = ends[2 * items[it]] - O, q = ends[2 * items[it] + 1] - O;
-        const Interval sh = held(nx * p.x + ny * p.y, radius[2 * it] * h, nx * q.x + ny * q.y, radius[2 * it + 1] * h);
+        const OpaqueBandScratch::Item& e = items[it];
+        const Interval sh = held(nx * e.p.x + ny * e.p.y, e.rp * h, nx * e.q.x + ny * e.q.y, e.rq * h);
         kept[m] = sh;
         m += sh.b > sh.a && sh.b > window.a && sh.a < window.b;
     }
@@ -126,17 +125,14 @@ void bucket_band(const Band& band, OpaqueBandScratch::Buckets& bb, double c_lo, 
     items.resize(first_of[static_cast<size_t>(S)]);
     auto& fill = ws.bucket_fill;
     fill.assign(first_of.begin(), first_of.end() - 1);
-    bb.radius.resize(2 * items.size());
     const Vec2* ends = ws.run_ends.data() + band.ends_first;
     for (size_t r = band.first; r < band.last; ++r) {
         const auto [a, b] = range[r - band.first];
         const size_t item = r - band.first;
         for (int sct = a; sct <= b; ++sct) {
-            const size_t at = fill[static_cast<size_t>(sct)]++;
-            items[at] = item;
-            const Vec2 O{band.t0, band.ya + (sct + 0.5) * band.w};  // as uncovered's
-            bb.radius[2 * at] = norm(ends[2 * item] - O);
-            bb.radius[2 * at + 1] = norm(ends[2 * item + 1] - O);
+            const Vec2 O{band.t0, band.ya + (sct + 0.5) * band.w};  // section sct's midpoint (uncovered's)
+            const Vec2 p = ends[2 * item] - O, q = ends[2 * item + 1] - O;
+            items[fill[static_cast<size_t>(sct)]++] = {p, q, norm(p), norm(q)};
         }
     }
 }
@@ -187,7 +183,7 @@ double band_free(const Band& band, OpaqueBandScratch::Buckets& bb, int b, int bi
     double sum = 0;
     for (int sct = 0; sct < S && sum <= bar; ++sct) {
         const size_t f = bb.first[static_cast<size_t>(sct)], l = bb.first[static_cast<size_t>(sct) + 1];
-        sum += uncovered(band, sct, n, h, bb.items.data() + f, bb.radius.data() + 2 * f, l - f, bar - sum, ws);
+        sum += uncovered(band, sct, n, h, bb.items.data() + f, l - f, bar - sum, ws);
     }
     return sum;
 }

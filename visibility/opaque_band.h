@@ -74,13 +74,18 @@ struct OpaqueBandScratch {
     std::vector<Band> bands;
     std::vector<Vec2> points;
     std::vector<double> radius;
+    /// A piece in a section's bucket: its ends p, q about the section's
+    /// midpoint O, and their distances |p|, |q| to it.
+    struct Item {
+        Vec2 p, q;
+        double rp, rq;
+    };
     /// A band's pieces by section, for a group of consecutive bins
     /// (band_bound's bins loop): items[first[s], first[s + 1]) are section
-    /// s's (positions in the band's run), radius[2 i], radius[2 i + 1]
-    /// item i's ends' distances to section s's midpoint.
+    /// s's, in the band's run order, read in sequence by each bin's check.
     struct Buckets {
-        std::vector<size_t> first, items;
-        std::vector<double> radius;  // per item, its ends' distances to its section's midpoint
+        std::vector<size_t> first;
+        std::vector<Item> items;
         int group = -1;       // the group they are for (-1: none yet)
         int group_size = 0;   // bins per group (0: not chosen yet)
     };
