@@ -107,7 +107,8 @@ void bucket_band(const Band& band, OpaqueBandScratch::Buckets& bb, double c_lo, 
     auto& range = ws.bucket_range;
     first_of.assign(static_cast<size_t>(S) + 1, 0);
     range.resize(band.last - band.first);
-    // (The band's ends in run order: build_band; items are run positions.)
+    // (The band's ends in run order: build_band. Each item keeps its
+    // piece's ends about its section's midpoint.)
     const Vec2* end = ws.run_ends.data() + band.ends_first;
     for (size_t r = band.first; r < band.last; ++r, end += 2) {
         const Vec2 p = end[0] - M, q = end[1] - M;
@@ -149,8 +150,9 @@ constexpr double bucket_group_turn = 2;
 
 // Bins per bucketing of band k: as many as keep each piece's turn within
 // the group (|P - M| times half the group's angle) under bucket_group_turn
-// sections' widths, so that a piece lands in at most about that many
-// sections more than at a single direction. (Bucketing every bin anew took
+// sections' widths, so that a piece lands in at most about twice that many
+// sections more than at the group's middle direction (that many on either
+// side). (Bucketing every bin anew took
 // a third of band_bound's samples on the 10^5 forest, where the bins of a
 // long shaft's proof barely turn; once per group, with the ends' distances
 // kept for uncovered: band_bound 8.4% fewer instructions on a 3x10^4 forest
