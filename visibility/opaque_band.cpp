@@ -152,17 +152,17 @@ constexpr double bucket_group_turn = 2;
 // the group (|P - M| times half the group's angle) under bucket_group_turn
 // sections' widths, so that a piece lands in at most about twice that many
 // sections more than at the group's middle direction (that many on either
-// side). (Bucketing every bin anew took
-// a third of band_bound's samples on the 10^5 forest, where the bins of a
-// long shaft's proof barely turn; once per group, with the ends' distances
-// kept for uncovered: band_bound 8.4% fewer instructions on a 3x10^4 forest
-// at eps 10, the same answers.)
+// side). (Bucketing every bin anew took a third of band_bound's samples on
+// the 10^5 forest, where the bins of a long shaft's proof barely turn; once
+// per group, with the ends' distances kept for uncovered: band_bound 8.4%
+// fewer instructions on a 3x10^4 forest at eps 10, the same answers.)
 int bucket_group_size(const Band& band, double h, int bins, const OpaqueBandScratch& ws) {
     const Vec2 M{band.t0, band.ya + 0.5 * band.sections * band.w};
-    double reach = 0;
+    double reach2 = 0;  // the largest |P - M|^2 (one root below, as bucket_band's turn)
     const Vec2* end = ws.run_ends.data() + band.ends_first;
     for (size_t r = band.first; r < band.last; ++r, end += 2)
-        reach = std::max({reach, norm(end[0] - M), norm(end[1] - M)});
+        reach2 = std::max({reach2, norm_squared(end[0] - M), norm_squared(end[1] - M)});
+    const double reach = std::sqrt(reach2);
     const double g = std::floor(bucket_group_turn * band.w / (reach * h));
     return std::isfinite(g) ? static_cast<int>(std::clamp(g, 1.0, static_cast<double>(bins))) : (g > 0 ? bins : 1);
 }
