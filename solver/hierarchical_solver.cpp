@@ -555,9 +555,16 @@ private:
     MultiscaleVisibility m_vis;
     std::vector<OrientedBox> m_obox;  // per hierarchy node (engine/oriented_box.h)
     // Transmittance between two hierarchy nodes, per unordered pair
-    // (symmetric: the lines joining the two cross-sections).
-    mutable std::unordered_map<uint64_t, std::pair<double, double>> m_tau_cache;
+    // (symmetric: the lines joining the two cross-sections), with the
+    // refinement wave that computed it (link_transmittance's patch
+    // shortcut takes only answers of earlier waves: see there).
+    struct TauEntry {
+        double tau, error_bound;
+        uint32_t wave;
+    };
+    mutable std::unordered_map<uint64_t, TauEntry> m_tau_cache;
     mutable std::shared_mutex m_tau_mutex;
+    uint32_t m_wave = 0;  // refinement waves so far (refine, one per wave)
     // Closure screens (behind_closure_screen): per element node, per
     // direction bin, 0 not asked yet, 1 shown closed, 2 not shown closed or
     // not possible there. m_screen_depth: where they stand (infinite: none
@@ -1374,25 +1381,32 @@ std::pair<double, double> HierarchicalSolver::link_transmittance(int r, int s, E
     const Node& nr = m_nodes[static_cast<size_t>(r)];
     const Node& ns = m_nodes[static_cast<size_t>(s)];
     const auto skip = [&](int h) { return m_tau_skip[static_cast<size_t>(h)]; };
-    auto lookup = [&](uint64_t key) -> std::optional<std::pair<double, double>> {
+    auto lookup = [&](uint64_t key) -> std::optional<TauEntry> {
         std::shared_lock lock(m_tau_mutex);
         const auto it = m_tau_cache.find(key);
         if (it == m_tau_cache.end()) return std::nullopt;
         return it->second;
     };
+    // Two threads may compute one key at once: the same answer, the query
+    // being a function of its arguments. The first stays, and only its
+    // work is counted, so that the stats are those of one thread.
     auto cached = [&](uint64_t key, const auto& compute) {
-        if (const auto known = lookup(key)) return *known;
-        const TransmittanceResult t = compute();
+        if (const auto known = lookup(key)) return std::make_pair(known->tau, known->error_bound);
+        VisibilityStats mine;
+        const TransmittanceResult t = compute(mine);
         std::unique_lock lock(m_tau_mutex);
-        m_tau_cache.emplace(key, std::make_pair(t.tau, t.error_bound));
+        if (m_tau_cache.emplace(key, TauEntry{t.tau, t.error_bound, m_wave}).second) st += mine;
         return std::make_pair(t.tau, t.error_bound);
     };
     if (nr.cluster() && ns.cluster()) {
         const uint64_t key = (static_cast<uint64_t>(std::min(nr.hnode, ns.hnode)) << 32) |
                              static_cast<uint32_t>(std::max(nr.hnode, ns.hnode));
-        return cached(key, [&] {
-            return m_vis.transmittance(nr.hnode, ns.hnode, skip(nr.hnode), skip(ns.hnode), m_vis_eps, GammaRule::Bound,
-                                       ws, st);
+        // Asked in one order, whichever link asks first: the two orders
+        // may differ in the last bits, and the links must not depend on
+        // which thread got there first.
+        const int a = std::min(nr.hnode, ns.hnode), b = std::max(nr.hnode, ns.hnode);
+        return cached(key, [&](VisibilityStats& mine) {
+            return m_vis.transmittance(a, b, skip(a), skip(b), m_vis_eps, GammaRule::Bound, ws, mine);
         });
     }
     const int e = nr.cluster() ? s : r;
@@ -1403,16 +1417,22 @@ std::pair<double, double> HierarchicalSolver::link_transmittance(int r, int s, E
     };
     const Node& ne = m_nodes[static_cast<size_t>(e)];
     const int root = ne.kind == Kind::Element ? m_patch_root[static_cast<size_t>(ne.patch)] : e;
+    // Only an answer of an earlier wave: whether one of this wave is there
+    // yet depends on the threads' timing, and the part's own query may
+    // differ from it (a closed patch's piece may get a partial bound), so
+    // taking it would make the links depend on that timing. Waves are
+    // decided in order, so which earlier answers exist does not.
     if (root != e)
         if (const auto whole = lookup(key_of(root)))
-            if (whole->second == 0 && (whole->first == 0 || whole->first >= 1 - 1e-12)) return *whole;
-    return cached(key_of(e), [&] {
+            if (whole->wave < m_wave && whole->error_bound == 0 && (whole->tau == 0 || whole->tau >= 1 - 1e-12))
+                return {whole->tau, whole->error_bound};
+    return cached(key_of(e), [&](VisibilityStats& mine) {
         if (behind_closure_screen(e, cluster_target_region(other.hnode, ne.seg.midpoint()), ws, st)) {
-            ++st.screened;
+            ++mine.screened;
             return TransmittanceResult{};  // closed, exactly
         }
         return m_vis.transmittance(ne.seg, skip(ne.hnode), other.hnode, skip(other.hnode), m_vis_eps, GammaRule::Bound,
-                                   ws, st);
+                                   ws, mine);
     });
 }
 
@@ -1463,9 +1483,16 @@ bool HierarchicalSolver::behind_closure_screen(int e, const Box& region, ExactWo
         const auto it = m_screens.find(e);
         if (it != m_screens.end() && it->second[static_cast<size_t>(k)] != 0) return it->second[static_cast<size_t>(k)] == 1;
     }
-    const bool closed = m_vis.shown_closed(ne.seg, m_tau_skip[static_cast<size_t>(ne.hnode)], *screen, ws, st);
+    // (Another thread may be proving the same screen: the same answer;
+    // the first to store it counts its work, as link_transmittance does.)
+    VisibilityStats mine;
+    const bool closed = m_vis.shown_closed(ne.seg, m_tau_skip[static_cast<size_t>(ne.hnode)], *screen, ws, mine);
     std::unique_lock lock(m_screen_mutex);
-    m_screens[e][static_cast<size_t>(k)] = closed ? 1 : 2;  // (another thread may have found the same)
+    int8_t& known = m_screens[e][static_cast<size_t>(k)];
+    if (known == 0) {
+        known = closed ? 1 : 2;
+        st += mine;
+    }
     return closed;
 }
 
@@ -1865,6 +1892,7 @@ bool HierarchicalSolver::refine(const std::vector<double>& leaf_bmax, double exi
         decision.assign(static_cast<size_t>(nw), 0);
         const auto t_decide = Clock::now();
         long resolved = 0;
+        ++m_wave;  // (link_transmittance: answers of this wave are not shortcuts within it)
 #pragma omp parallel num_threads(m_threads) if (nw > parallel_min_work)
         {
             ExactWorkspace ws;
