@@ -94,6 +94,8 @@ int Scene::channels() const { return m_impl->scene.channels; }
 std::size_t Scene::patch_count() const { return m_impl->scene.patches.size(); }
 std::size_t Scene::segment_count() const { return m_impl->scene.segments.size(); }
 
+const std::vector<std::string>& Scene::warnings() const { return m_impl->scene.warnings; }
+
 std::vector<std::string> Scene::surface_names() const {
     std::vector<std::string> names;
     names.reserve(m_impl->scene.surfaces.size());

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
 #include <limits>
 #include <memory>
 #include <numbers>
@@ -831,15 +832,71 @@ public:
             scene.name = std::filesystem::path(m_file).stem().string();
         }
 
+        note_unknown_keys(root, {"flatrad", "name", "description", "materials", "surfaces"}, "");
         read_materials(require(root, "materials", ""), scene);
         read_surfaces(require(root, "surfaces", ""), scene);
         check_no_overlaps(scene);
+        scene.warnings = std::move(m_warnings);
+        if (m_unknown_keys > max_scene_warnings)
+            scene.warnings.push_back(fmt::format("and {} more unknown keys, ignored", m_unknown_keys - max_scene_warnings));
         return scene;
     }
 
 private:
     [[noreturn]] void fail(const std::string& path, const std::string& message) const {
         throw InputError(m_file, path, message);
+    }
+
+    /// Records the keys of `object` (at `path`) that are not among `known`
+    /// (Scene::warnings): they are ignored, as the format allows, but said.
+    void note_unknown_keys(const Json& object, std::initializer_list<std::string_view> known,
+                           const std::string& path) const {
+        if (!object.is_object()) return;
+        for (const auto& item : object.items()) {
+            const std::string& key = item.key();
+            if (std::find(known.begin(), known.end(), key) != known.end()) continue;
+            if (++m_unknown_keys > max_scene_warnings) continue;
+            std::string line = fmt::format("{}: unknown key, ignored", key_path(path, key));
+            if (const auto meant = likely_meant(key, known)) line += fmt::format(" (did you mean \"{}\"?)", *meant);
+            m_warnings.push_back(std::move(line));
+        }
+    }
+
+    /// The known key nearest to `key` when it is at most two edits away
+    /// (insertions, deletions, substitutions; letters compared without case),
+    /// the nearest first in `known`'s order on ties.
+    static std::optional<std::string_view> likely_meant(const std::string& key,
+                                                        std::initializer_list<std::string_view> known) {
+        constexpr size_t max_edits = 2;
+        std::optional<std::string_view> best;
+        size_t best_edits = max_edits + 1;
+        for (std::string_view k : known) {
+            const size_t d = edit_distance(key, k, best_edits);
+            if (d < best_edits) {
+                best_edits = d;
+                best = k;
+            }
+        }
+        return best;
+    }
+
+    /// Levenshtein distance between a and b, or `cap` when it is at least
+    /// that (one row of the table; keys are short).
+    static size_t edit_distance(std::string_view a, std::string_view b, size_t cap) {
+        if ((a.size() > b.size() ? a.size() - b.size() : b.size() - a.size()) >= cap) return cap;
+        auto lower = [](char c) { return c >= 'A' && c <= 'Z' ? static_cast<char>(c - 'A' + 'a') : c; };
+        std::vector<size_t> row(b.size() + 1);
+        for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+        for (size_t i = 1; i <= a.size(); ++i) {
+            size_t diagonal = row[0];
+            row[0] = i;
+            for (size_t j = 1; j <= b.size(); ++j) {
+                const size_t above = row[j];
+                row[j] = std::min({above + 1, row[j - 1] + 1, diagonal + (lower(a[i - 1]) == lower(b[j - 1]) ? 0 : 1)});
+                diagonal = above;
+            }
+        }
+        return std::min(row[b.size()], cap);
     }
 
     const Json& require(const Json& object, const char* key, const std::string& object_path) const {
@@ -879,6 +936,7 @@ private:
             if (!m.is_object())
                 fail(path, fmt::format("expected an object {{\"reflectance\": ..., \"emission\": ...}}, found {}",
                                        describe(m)));
+            note_unknown_keys(m, {"reflectance", "emission"}, path);
             Material material;
             material.name = item.key();
             scene.materials.push_back(material);
@@ -960,6 +1018,7 @@ private:
                 fail(path, fmt::format("expected a surface object {{\"name\", \"material\", \"points\" or "
                                        "\"circle\", ...}}, found {}",
                                        describe(s)));
+            note_unknown_keys(s, {"name", "material", "points", "circle", "closed", "side"}, path);
             Surface surface;
 
             // Name, unique in the scene.
@@ -1156,6 +1215,7 @@ private:
         if (!circle.is_object())
             fail(path, fmt::format("expected {{\"center\": [x, y], \"radius\": r, \"segments\": n}}, found {}",
                                    describe(circle)));
+        note_unknown_keys(circle, {"center", "radius", "segments"}, path);
         const Vec2 center = read_point(require(circle, "center", path), key_path(path, "center"));
 
         const std::string radius_path = key_path(path, "radius");
@@ -1409,6 +1469,9 @@ private:
     }
 
     const std::string& m_file;
+    // Scene::warnings while reading (the const readers note what they skip).
+    mutable std::vector<std::string> m_warnings;
+    mutable size_t m_unknown_keys = 0;  // every one, also those past max_scene_warnings
     std::optional<size_t> m_channels;  // length of the first channel array seen
     std::string m_channels_path;       // where it was seen, for messages
 };

@@ -67,6 +67,12 @@ struct Scene {
     std::vector<Surface> surfaces;
     std::vector<SceneSegment> segments;  ///< SPEC numbering: surface by surface, point order
     std::vector<Patch> patches;          ///< SPEC numbering: per segment, left/in before right/out
+    /// What the file holds that the reader ignored: keys it does not know
+    /// (a misspelt "emision" would otherwise leave a lamp dark without a
+    /// word). One line each, "PATH: unknown key ..." (with a likely meant
+    /// key when one is close), at most max_scene_warnings of them, then one
+    /// line counting the rest. For the caller to show; nothing is refused.
+    std::vector<std::string> warnings;
 
     /// Plain segment geometry, index-aligned with `segments` (for hierarchy building).
     std::vector<Segment> segment_geometry() const;
@@ -77,6 +83,9 @@ struct Scene {
     /// Length of the scene's bounding box diagonal (the scale for length tolerances).
     double extent() const;
 };
+
+/// Scene::warnings keeps this many lines, then one saying how many more.
+constexpr size_t max_scene_warnings = 10;
 
 /// Most memory a scene may take to hold: its segments, its patches (two
 /// per segment at most) and the cluster hierarchy built over them. 1 GiB,

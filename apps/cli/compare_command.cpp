@@ -1,3 +1,4 @@
+#include "cli/scene_warnings.h"
 #include "cli/compare_command.h"
 
 #include <algorithm>
@@ -96,7 +97,7 @@ int run_compare(const CompareArgs& args, std::ostream& out, std::ostream& err) {
         throw UsageError(fmt::format("--threads: expected an integer >= 0, got {}", args.threads));
     if (!args.output.empty()) check_output_path(args.output, "-o");
 
-    const Scene scene = load_scene(args.scene);
+    const Scene scene = load_scene_reporting(args.scene, err);
     const long patches = static_cast<long>(scene.patches.size());
     if (!reference_fits(scene, args.subdivide, args.max_elements))
         throw UsageError(fmt::format("--subdivide {}: {} patches x {} elements is beyond --max-elements {} or "

@@ -1,3 +1,4 @@
+#include "cli/scene_warnings.h"
 #include "cli/formfactor_command.h"
 
 #include <algorithm>
@@ -53,7 +54,7 @@ std::vector<int> surface_group(const Scene& scene, const std::string& names, con
     return group;
 }
 
-int run_formfactor(const FormFactorArgs& args, std::ostream& out, std::ostream& /*err*/) {
+int run_formfactor(const FormFactorArgs& args, std::ostream& out, std::ostream& err) {
     FormFactorMethod method;
     if (args.method == "multiscale")
         method = FormFactorMethod::Multiscale;
@@ -66,7 +67,7 @@ int run_formfactor(const FormFactorArgs& args, std::ostream& out, std::ostream& 
     if (args.eps && !(std::isfinite(*args.eps) && *args.eps >= 0))
         throw UsageError(fmt::format("--eps: expected a finite number >= 0, got {}", *args.eps));
 
-    const Scene scene = load_scene(args.scene);
+    const Scene scene = load_scene_reporting(args.scene, err);
     const std::vector<int> from = surface_group(scene, args.from, "--from");
     const std::vector<int> to = surface_group(scene, args.to, "--to");
     GroupFormFactorOptions options;

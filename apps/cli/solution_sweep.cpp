@@ -1,3 +1,4 @@
+#include "cli/scene_warnings.h"
 #include "cli/solution_sweep.h"
 
 #include <algorithm>
@@ -326,7 +327,7 @@ int run_solution_sweep_command(const SweepArgs& args, std::ostream& out, std::os
     if (!args.svg.empty())
         for (const auto& [kind, path] : plots) check_output_path(path, "--svg");
 
-    const Scene scene = load_scene(args.scene);
+    const Scene scene = load_scene_reporting(args.scene, err);
     const long patches = static_cast<long>(scene.patches.size());
     if (!reference_fits(scene, o.reference.subdivide, o.reference.max_elements))
         throw UsageError(fmt::format("--subdivide {}: {} patches x {} elements is beyond --max-elements {} or the "

@@ -1,3 +1,4 @@
+#include "cli/scene_warnings.h"
 #include "cli/solve_command.h"
 
 #include <cmath>
@@ -44,7 +45,7 @@ void check_arguments(const SolveArgs& args) {
 
 int run_solve(const SolveArgs& args, std::ostream& out, std::ostream& err) {
     check_arguments(args);
-    const Scene scene = load_scene(args.scene);
+    const Scene scene = load_scene_reporting(args.scene, err);
     Solution solution;
     if (args.method == "hierarchical") {
         HierarchicalOptions options;

@@ -1,3 +1,4 @@
+#include "cli/scene_warnings.h"
 #include "cli/sweep_command.h"
 
 
@@ -440,7 +441,7 @@ int run_sweep(const SweepArgs& args, std::ostream& out, std::ostream& err) {
     if (!args.svg.empty())
         for (const auto& [kind, path] : plots) check_output_path(path, "--svg");
 
-    const Scene scene = load_scene(args.scene);
+    const Scene scene = load_scene_reporting(args.scene, err);
     const std::vector<int> from = surface_group(scene, from_names, "--from");
     const std::vector<int> to = surface_group(scene, to_names, "--to");
 

@@ -88,6 +88,10 @@ public:
     std::size_t segment_count() const;
     /// Surface names in file (or builder) order.
     std::vector<std::string> surface_names() const;
+    /// What the reader ignored, one line each ("PATH: unknown key, ignored",
+    /// with the key likely meant when one is close, e.g. "emision"): at most
+    /// ten, then a line counting the rest. Empty for a clean file.
+    const std::vector<std::string>& warnings() const;
 
     /// Internal: Scenes come from load_scene, parse_scene and
     /// SceneBuilder::build (Impl is defined in api/flatrad_api.cpp).

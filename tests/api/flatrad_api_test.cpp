@@ -49,6 +49,8 @@ TEST_CASE("api: a built scene solves exactly like the same scene read from its f
     CHECK(built.channels() == 1);
     CHECK(built.segment_count() == 4);
     CHECK(built.surface_names() == std::vector<std::string>{"floor", "walls"});
+    CHECK(built.warnings().empty());
+    CHECK(read.warnings().empty());
 
     api::SolveOptions options;
     options.method = api::Method::Exact;
@@ -176,4 +178,11 @@ TEST_CASE("api: form factors between groups of surfaces") {
     // In the closed box the floor sees the walls, and nothing else.
     const api::Scene box = closed_box().build();
     CHECK(api::form_factor(box, {"floor"}, {"walls", "walls"}) == doctest::Approx(1.0).epsilon(1e-12));
+}
+
+TEST_CASE("api: a scene's ignored keys are there to show") {
+    const api::Scene s = api::parse_scene(R"({"flatrad": 1, "materials": {"lamp": {"emision": 1}},
+        "surfaces": [{"name": "a", "material": "lamp", "points": [[0, 0], [1, 0]]}]})", "typo.json");
+    REQUIRE(s.warnings().size() == 1);
+    CHECK(s.warnings()[0] == "materials.lamp.emision: unknown key, ignored (did you mean \"emission\"?)");
 }

@@ -173,6 +173,34 @@ TEST_CASE("cli: bad scene files give status 2 and one line naming file and path"
     }
 }
 
+TEST_CASE("cli: a misspelt key is said on stderr, and the scene solved as written") {
+    // engine/scene.h, Scene::warnings: one line each, "warning: FILE: PATH:
+    // ...", with or without --quiet; the exit status and result as without
+    // the key.
+    TempDir tmp;
+    const std::string typo = tmp.file("typo.json", R"({
+      "flatrad": 1,
+      "materials": { "lamp": { "emission": 1.0 }, "grey": { "reflectance": 0.5, "emision": 3 } },
+      "surfaces": [
+        { "name": "lamp", "material": "lamp", "points": [[0, 0], [1, 0]] },
+        { "name": "plate", "material": "grey", "points": [[1, 1], [0, 1]] }
+      ]
+    })");
+    const std::string clean = tmp.file("clean.json", two_plates);
+    for (const char* quiet : {"-q", "--threads=1"}) {
+        CAPTURE(quiet);
+        const Run r = run({"solve", typo, "--method", "exact", quiet});
+        const Run c = run({"solve", clean, "--method", "exact", quiet});
+        CHECK(r.status == 0);
+        const std::string line = "warning: " + typo + ": materials.grey.emision: unknown key, ignored (did you mean \"emission\"?)\n";
+        CHECK(r.err.rfind(line, 0) == 0);
+        CHECK(r.err.find("warning", line.size()) == std::string::npos);  // that one line only
+        const json a = json::parse(r.out), b = json::parse(c.out);
+        CHECK(a["patches"] == b["patches"]);
+        CHECK(c.err.find("warning") == std::string::npos);
+    }
+}
+
 TEST_CASE("cli: solve writes the SPEC result file to stdout") {
     TempDir tmp;
     const std::string scene = tmp.file("room.json", lit_room);

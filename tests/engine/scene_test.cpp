@@ -3,12 +3,16 @@
 // patch numbering and lit sides, and the scenes in data/.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <numbers>
 #include <optional>
 #include <string>
+#include <vector>
+
+#include <fmt/format.h>
 
 #include "engine/error.h"
 #include "engine/scene.h"
@@ -646,4 +650,57 @@ TEST_CASE("scene: every data/*.json parses") {
         ++count;
     }
     CHECK(count >= 1);
+}
+
+TEST_CASE("scene: unknown keys are read past and said, with the key likely meant") {
+    // A misspelt key would otherwise change the answer without a word (a
+    // lamp whose "emision" is ignored is dark). Nothing is refused: the
+    // scene is the one without the unknown keys.
+    const std::string clean = R"({"flatrad": 1, "description": "known: free text",
+        "materials": {"white": {"reflectance": 0.5}, "lamp": {"emission": 1}},
+        "surfaces": [{"name": "room", "material": "white", "circle": {"center": [0, 0], "radius": 1, "segments": 8}, "side": "in"},
+                     {"name": "lamp", "material": "lamp", "points": [[0, 0], [0.1, 0]], "side": "both"}]})";
+    const Scene a = parse_scene(clean, label);
+    CHECK(a.warnings.empty());
+    const std::string typos = R"({"flatrad": 1, "comment": 1,
+        "materials": {"white": {"reflectance": 0.5, "Reflectence": 2}, "lamp": {"emission": 1, "emision": 5}},
+        "surfaces": [{"name": "room", "material": "white", "circle": {"center": [0, 0], "radius": 1, "segments": 8, "radious": 3}, "side": "in", "sides": "out"},
+                     {"name": "lamp", "material": "lamp", "points": [[0, 0], [0.1, 0]], "side": "both", "xyz": []}]})";
+    const Scene b = parse_scene(typos, label);
+    const std::vector<std::string> want = {
+        "comment: unknown key, ignored",
+        "materials.white.Reflectence: unknown key, ignored (did you mean \"reflectance\"?)",
+        "materials.lamp.emision: unknown key, ignored (did you mean \"emission\"?)",
+        "surfaces[0].circle.radious: unknown key, ignored (did you mean \"radius\"?)",
+        "surfaces[0].sides: unknown key, ignored (did you mean \"side\"?)",
+        "surfaces[1].xyz: unknown key, ignored",
+    };
+    CHECK(b.warnings.size() == want.size());
+    for (const std::string& w : want) {
+        CAPTURE(w);
+        CHECK(std::find(b.warnings.begin(), b.warnings.end(), w) != b.warnings.end());
+    }
+    // The same scene as without them.
+    REQUIRE(a.patches.size() == b.patches.size());
+    REQUIRE(a.materials.size() == b.materials.size());
+    for (size_t m = 0; m < a.materials.size(); ++m) {
+        CHECK(a.materials[m].reflectance == b.materials[m].reflectance);
+        CHECK(a.materials[m].emission == b.materials[m].emission);
+    }
+    for (size_t s = 0; s < a.segments.size(); ++s) {
+        CHECK(a.segments[s].seg.a == b.segments[s].seg.a);
+        CHECK(a.segments[s].seg.b == b.segments[s].seg.b);
+    }
+}
+
+TEST_CASE("scene: unknown keys past ten are counted, not listed") {
+    std::string surfaces;
+    const int n = 25;
+    for (int k = 0; k < n; ++k)
+        surfaces += fmt::format(R"({}{{"name": "s{}", "material": "white", "points": [[{}, 0], [{}, 1]], "colour": 1}})",
+                                k == 0 ? "" : ",", k, k, k);
+    const Scene s = parse_scene(scene_json(surfaces), label);
+    REQUIRE(s.warnings.size() == max_scene_warnings + 1);
+    CHECK(s.warnings.front() == "surfaces[0].colour: unknown key, ignored");
+    CHECK(s.warnings.back() == fmt::format("and {} more unknown keys, ignored", n - static_cast<int>(max_scene_warnings)));
 }
