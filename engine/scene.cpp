@@ -832,13 +832,17 @@ public:
             scene.name = std::filesystem::path(m_file).stem().string();
         }
 
+        if (const Json* description = optional(root, "description"); description && !description->is_string())
+            fail("description", fmt::format("expected a string (free text), found {}", describe(*description)));
         note_unknown_keys(root, {"flatrad", "name", "description", "materials", "surfaces"}, "");
         read_materials(require(root, "materials", ""), scene);
         read_surfaces(require(root, "surfaces", ""), scene);
         check_no_overlaps(scene);
         scene.warnings = std::move(m_warnings);
-        if (m_unknown_keys > max_scene_warnings)
-            scene.warnings.push_back(fmt::format("and {} more unknown keys, ignored", m_unknown_keys - max_scene_warnings));
+        if (m_unknown_keys > max_scene_warnings) {
+            const size_t more = m_unknown_keys - max_scene_warnings;
+            scene.warnings.push_back(fmt::format("and {} more unknown key{}, ignored", more, more == 1 ? "" : "s"));
+        }
         return scene;
     }
 
@@ -856,28 +860,49 @@ private:
             const std::string& key = item.key();
             if (std::find(known.begin(), known.end(), key) != known.end()) continue;
             if (++m_unknown_keys > max_scene_warnings) continue;
-            std::string line = fmt::format("{}: unknown key, ignored", key_path(path, key));
+            std::string line = fmt::format("{}: unknown key, ignored", key_path(path, printable_key(key)));
             if (const auto meant = likely_meant(key, known)) line += fmt::format(" (did you mean \"{}\"?)", *meant);
             m_warnings.push_back(std::move(line));
         }
     }
 
-    /// The known key nearest to `key` when it is at most two edits away
+    /// The known key nearest to `key` when it is within max_edits of it
     /// (insertions, deletions, substitutions; letters compared without case),
-    /// the nearest first in `known`'s order on ties.
+    /// the first in `known`'s order on ties.
     static std::optional<std::string_view> likely_meant(const std::string& key,
                                                         std::initializer_list<std::string_view> known) {
-        constexpr size_t max_edits = 2;
         std::optional<std::string_view> best;
-        size_t best_edits = max_edits + 1;
+        size_t best_edits = std::numeric_limits<size_t>::max();
         for (std::string_view k : known) {
-            const size_t d = edit_distance(key, k, best_edits);
-            if (d < best_edits) {
+            const size_t d = edit_distance(key, k, max_edits(k) + 1);
+            if (d <= max_edits(k) && d < best_edits) {
                 best_edits = d;
                 best = k;
             }
         }
         return best;
+    }
+
+    /// How far a misspelling of `key` may be: one edit for keys of four
+    /// letters or fewer ("note" is not "name"), two for longer ones.
+    static size_t max_edits(std::string_view key) { return key.size() <= 4 ? 1 : 2; }
+
+    /// `a` when not empty, else `b`.
+    static std::string first_of(std::string a, std::string b) { return a.empty() ? b : a; }
+
+    /// A key as it may be shown in one line: control characters escaped
+    /// (\n, \u001b, ...: a key must not start a line of its own), then
+    /// shortened as other echoed text is.
+    static std::string printable_key(std::string_view key) {
+        std::string out;
+        for (const char c : key) {
+            const auto u = static_cast<unsigned char>(c);
+            if (u < 0x20 || u == 0x7f)
+                out += c == '\n' ? std::string("\\n") : c == '\t' ? std::string("\\t") : fmt::format("\\u{:04x}", u);
+            else
+                out += c;
+        }
+        return shorten(std::move(out));
     }
 
     /// Levenshtein distance between a and b, or `cap` when it is at least
@@ -901,8 +926,19 @@ private:
 
     const Json& require(const Json& object, const char* key, const std::string& object_path) const {
         const auto it = object.find(key);
-        if (it == object.end()) fail(key_path(object_path, key), "missing required key");
+        if (it == object.end()) fail(key_path(object_path, key), "missing required key" + misspelt_hint(object, key));
         return *it;
+    }
+
+    /// ", found \"KEY\": misspelt?" for the first key of `object` close to
+    /// the missing `key` (likely_meant's distance), else "": a misspelt
+    /// required key is then named where the error is.
+    static std::string misspelt_hint(const Json& object, std::string_view key) {
+        if (!object.is_object()) return "";
+        for (const auto& item : object.items())
+            if (item.key() != key && edit_distance(item.key(), key, max_edits(key) + 1) <= max_edits(key))
+                return fmt::format(" (found \"{}\": misspelt?)", printable_key(item.key()));
+        return "";
     }
 
     static const Json* optional(const Json& object, const char* key) {
@@ -1047,7 +1083,8 @@ private:
             const Json* circle = optional(s, "circle");
             if (points && circle) fail(path, "expected either \"points\" or \"circle\", found both");
             if (!points && !circle)
-                fail(key_path(path, "points"), "missing required key (a surface needs \"points\" or \"circle\")");
+                fail(key_path(path, "points"), "missing required key (a surface needs \"points\" or \"circle\")" +
+                                                   first_of(misspelt_hint(s, "points"), misspelt_hint(s, "circle")));
             surface.is_circle = circle != nullptr;
 
             if (const Json* closed = optional(s, "closed")) {
@@ -1140,7 +1177,9 @@ private:
         const std::string at = key_path(path, "side");
         const Json* side = optional(s, "side");
         if (!side) {
-            if (closed) fail(at, "missing required key (a closed shape needs \"side\": \"in\", \"out\" or \"both\")");
+            if (closed)
+                fail(at, "missing required key (a closed shape needs \"side\": \"in\", \"out\" or \"both\")" +
+                             misspelt_hint(s, "side"));
             return Side::Left;
         }
         if (!side->is_string())

@@ -1370,7 +1370,8 @@ bool HierarchicalSolver::resolve_visibility(Link& l, ExactWorkspace& ws, Visibil
 // with an element (or sink) at one end, per element and hierarchy node, the
 // element being its own stand-in (multiscale.h), so that the halves of a
 // patch each get their own shadow. A part of a patch takes its patch's
-// answer when that is known (cached) and settled: a clear (or closed) shaft
+// answer when an earlier refinement wave found it (cached) and it is
+// settled (see the shortcut below for why earlier): a clear (or closed) shaft
 // from the whole patch is clear (closed) from any piece of it. It does not
 // ask for the patch's answer only to learn that: in a crowded shaft the
 // answer is partial, and asking cost a room's long walls a second query

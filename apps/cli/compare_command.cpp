@@ -1,4 +1,3 @@
-#include "cli/scene_warnings.h"
 #include "cli/compare_command.h"
 
 #include <algorithm>
@@ -14,6 +13,7 @@
 
 #include "cli/atomic_write.h"
 #include "cli/progress.h"
+#include "cli/scene_warnings.h"
 #include "cli/usage_error.h"
 #include "engine/error.h"
 #include "solver/hierarchical_solver.h"

@@ -1,4 +1,3 @@
-#include "cli/scene_warnings.h"
 #include "cli/formfactor_command.h"
 
 #include <algorithm>
@@ -10,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/result_json.h"
+#include "cli/scene_warnings.h"
 #include "cli/usage_error.h"
 #include "engine/error.h"
 #include "solver/group_form_factor.h"

@@ -1,4 +1,3 @@
-#include "cli/scene_warnings.h"
 #include "cli/solution_sweep.h"
 
 #include <algorithm>
@@ -14,6 +13,7 @@
 #include "cli/median.h"
 #include "cli/parse_whole.h"
 #include "cli/progress.h"
+#include "cli/scene_warnings.h"
 #include "cli/usage_error.h"
 #include "solver/hierarchical_solver.h"
 

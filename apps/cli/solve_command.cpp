@@ -1,4 +1,3 @@
-#include "cli/scene_warnings.h"
 #include "cli/solve_command.h"
 
 #include <cmath>
@@ -10,6 +9,7 @@
 #include "cli/progress.h"
 #include "cli/result_json.h"
 #include "cli/scene_svg.h"
+#include "cli/scene_warnings.h"
 #include "cli/summary.h"
 #include "cli/usage_error.h"
 #include "engine/scene.h"

@@ -1,4 +1,3 @@
-#include "cli/scene_warnings.h"
 #include "cli/sweep_command.h"
 
 
@@ -18,6 +17,7 @@
 #include "cli/median.h"
 #include "cli/parse_whole.h"
 #include "cli/reference_solution.h"
+#include "cli/scene_warnings.h"
 #include "cli/solution_sweep.h"
 #include "cli/svg_plot.h"
 #include "cli/usage_error.h"

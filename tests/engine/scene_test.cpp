@@ -647,6 +647,7 @@ TEST_CASE("scene: every data/*.json parses") {
         Scene s;
         CHECK_NOTHROW(s = load_scene(entry.path().string()));
         CHECK(!s.patches.empty());
+        CHECK(s.warnings.empty());  // our own scenes use only keys the reader knows
         ++count;
     }
     CHECK(count >= 1);
@@ -703,4 +704,48 @@ TEST_CASE("scene: unknown keys past ten are counted, not listed") {
     REQUIRE(s.warnings.size() == max_scene_warnings + 1);
     CHECK(s.warnings.front() == "surfaces[0].colour: unknown key, ignored");
     CHECK(s.warnings.back() == fmt::format("and {} more unknown keys, ignored", n - static_cast<int>(max_scene_warnings)));
+    // At the boundary: ten are all listed, the eleventh is "1 more".
+    for (const int m : {10, 11}) {
+        CAPTURE(m);
+        std::string some;
+        for (int k = 0; k < m; ++k)
+            some += fmt::format(R"({}{{"name": "s{}", "material": "white", "points": [[{}, 0], [{}, 1]], "colour": 1}})",
+                                k == 0 ? "" : ",", k, k, k);
+        const Scene t = parse_scene(scene_json(some), label);
+        CHECK(t.warnings.size() == max_scene_warnings + (m > 10 ? 1 : 0));
+        if (m == 11) CHECK(t.warnings.back() == "and 1 more unknown key, ignored");
+    }
+}
+
+TEST_CASE("scene: an unknown key is shown on one line, and short keys are not over-corrected") {
+    const Scene s = parse_scene(R"({"flatrad": 1, "note": 1, "a\nwarning: forged": 2,
+        "materials": {"white": {}}, "surfaces": [)" + floor_surface + "]}", label);
+    REQUIRE(s.warnings.size() == 2);
+    CHECK(s.warnings[0] == "note: unknown key, ignored");  // not "did you mean name": two edits of four letters
+    CHECK(s.warnings[1] == "a\\nwarning: forged: unknown key, ignored");
+    for (const std::string& w : s.warnings) CHECK(w.find('\n') == std::string::npos);
+}
+
+TEST_CASE("scene: a missing required key names a close misspelling") {
+    const auto near = [](const std::string& text) {
+        const auto err = refusal(text);
+        REQUIRE(err);
+        return err->path() + ": " + err->message();
+    };
+    CHECK(near(scene_json(R"({"name": "a", "materail": "white", "points": [[0, 0], [1, 0]]})")) ==
+          "surfaces[0].material: missing required key (found \"materail\": misspelt?)");
+    CHECK(near(scene_json(R"({"name": "a", "material": "white", "circle": {"center": [0, 0], "radious": 1, "segments": 8}, "side": "in"})")) ==
+          "surfaces[0].circle.radius: missing required key (found \"radious\": misspelt?)");
+    CHECK(near(scene_json(R"({"name": "a", "material": "white", "closed": true, "sid": "in", "points": [[0, 0], [1, 0], [0, 1]]})")) ==
+          "surfaces[0].side: missing required key (a closed shape needs \"side\": \"in\", \"out\" or \"both\") (found \"sid\": misspelt?)");
+    CHECK(near(scene_json(R"({"name": "a", "material": "white", "point": [[0, 0], [1, 0]]})")) ==
+          "surfaces[0].points: missing required key (a surface needs \"points\" or \"circle\") (found \"point\": misspelt?)");
+    // Nothing close: the plain message.
+    CHECK(near(scene_json(R"({"name": "a", "colour": "white", "points": [[0, 0], [1, 0]]})")) ==
+          "surfaces[0].material: missing required key");
+}
+
+TEST_CASE("scene: a description must be text") {
+    CHECK_REFUSED(R"({"flatrad": 1, "description": 5, "materials": {"white": {}}, "surfaces": [)" + floor_surface + "]}",
+                  "description");
 }

@@ -10,6 +10,7 @@
 #include <doctest/doctest.h>
 
 #include <fmt/format.h>
+#include <omp.h>
 #include <string>
 
 #include "engine/scene.h"
@@ -59,7 +60,10 @@ void check_same(const Solution& a, const Solution& b) {
     CHECK(differing == 0);
 }
 
-void check_thread_independent(const Scene& scene, HierarchicalOptions o, int runs) {
+Solution check_thread_independent(const Scene& scene, HierarchicalOptions o, int runs) {
+    // Two threads must really run (a thread limit of 1 would make this
+    // test compare one thread with itself).
+    REQUIRE(omp_get_thread_limit() >= 2);
     o.threads = 1;
     const Solution one = solve_hierarchical(scene, o);
     MESSAGE(fmt::format("eps {}: links {}, queries {}, screens {}", o.eps, one.stats.links,
@@ -71,6 +75,7 @@ void check_thread_independent(const Scene& scene, HierarchicalOptions o, int run
         REQUIRE(two.stats.threads == 2);
         check_same(one, two);
     }
+    return one;
 }
 
 }  // namespace
@@ -95,5 +100,7 @@ TEST_CASE("hierarchical threads: closure screens give the same solution with one
     const Scene scene = parse_scene(forest_json(6400, 8, 8, 3), "forest6400.json");
     HierarchicalOptions o;
     o.eps = 10;
-    check_thread_independent(scene, o, 2);
+    const Solution one = check_thread_independent(scene, o, 2);
+    CHECK(one.stats.visibility.screens > 0);  // (what this case is for)
+    CHECK(one.stats.visibility.screened > 0);
 }
