@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <optional>
 
 #include <boost/graph/adjacency_list.hpp>
@@ -108,14 +109,17 @@ constexpr size_t loop_scan_limit = 32;
 /// with a cluster hierarchy over them when the loop is large.
 class LoopEdges {
 public:
-    explicit LoopEdges(const SceneLoop& loop) : m_polygon(&loop.polygon) {
+    /// The loop's edge_tree when it has one, else one built here (for a loop
+    /// of more than loop_scan_limit edges).
+    explicit LoopEdges(const SceneLoop& loop) : m_polygon(&loop.polygon), m_tree(loop.edge_tree) {
         const size_t n = loop.polygon.size();
-        if (n > loop_scan_limit) {
+        if (!m_tree && n > loop_scan_limit) {
             std::vector<Segment> edges(n);
             for (size_t k = 0; k < n; ++k) edges[k] = edge(static_cast<int>(k));
-            m_tree.emplace(edges, 4);
+            m_tree = std::make_shared<const Hierarchy>(edges, 4);
         }
     }
+    const std::shared_ptr<const Hierarchy>& tree() const { return m_tree; }
     int size() const { return static_cast<int>(m_polygon->size()); }
     Segment edge(int k) const {
         const auto& p = *m_polygon;
@@ -133,7 +137,7 @@ public:
 
 private:
     const std::vector<Vec2>* m_polygon;
-    std::optional<Hierarchy> m_tree;
+    std::shared_ptr<const Hierarchy> m_tree;  // null: scan the edges
 };
 
 /// Certified simple (SceneLoop::simple): every pair of segments whose boxes
@@ -334,6 +338,7 @@ Connectivity scene_connectivity(const Scene& scene) {
 
         const LoopEdges edges(loop);
         loop.simple = certify_simple(loop, edges, stack);
+        loop.edge_tree = edges.tree();  // (escape_free_patches' tests use it again)
         loop.orientation = loop.simple ? certify_orientation(loop) : 0;
         obj.loop = static_cast<int>(cx.loops.size());
         cx.loops.push_back(std::move(loop));
