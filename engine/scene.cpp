@@ -887,9 +887,6 @@ private:
     /// letters or fewer ("note" is not "name"), two for longer ones.
     static size_t max_edits(std::string_view key) { return key.size() <= 4 ? 1 : 2; }
 
-    /// `a` when not empty, else `b`.
-    static std::string first_of(std::string a, std::string b) { return a.empty() ? b : a; }
-
     /// A key as it may be shown in one line: control characters escaped
     /// (\n, \u001b, ...: a key must not start a line of its own), then
     /// shortened as other echoed text is.
@@ -926,17 +923,17 @@ private:
 
     const Json& require(const Json& object, const char* key, const std::string& object_path) const {
         const auto it = object.find(key);
-        if (it == object.end()) fail(key_path(object_path, key), "missing required key" + misspelt_hint(object, key));
+        if (it == object.end()) fail(key_path(object_path, key), "missing required key" + misspelt_hint(object, {key}));
         return *it;
     }
 
-    /// ", found \"KEY\": misspelt?" for the first key of `object` close to
-    /// the missing `key` (likely_meant's distance), else "": a misspelt
+    /// " (found \"KEY\": misspelt?)" for the first key of `object` that
+    /// likely_meant takes for one of the missing `keys`, else "": a misspelt
     /// required key is then named where the error is.
-    static std::string misspelt_hint(const Json& object, std::string_view key) {
+    static std::string misspelt_hint(const Json& object, std::initializer_list<std::string_view> keys) {
         if (!object.is_object()) return "";
         for (const auto& item : object.items())
-            if (item.key() != key && edit_distance(item.key(), key, max_edits(key) + 1) <= max_edits(key))
+            if (std::find(keys.begin(), keys.end(), item.key()) == keys.end() && likely_meant(item.key(), keys))
                 return fmt::format(" (found \"{}\": misspelt?)", printable_key(item.key()));
         return "";
     }
@@ -1084,7 +1081,7 @@ private:
             if (points && circle) fail(path, "expected either \"points\" or \"circle\", found both");
             if (!points && !circle)
                 fail(key_path(path, "points"), "missing required key (a surface needs \"points\" or \"circle\")" +
-                                                   first_of(misspelt_hint(s, "points"), misspelt_hint(s, "circle")));
+                                                   misspelt_hint(s, {"points", "circle"}));
             surface.is_circle = circle != nullptr;
 
             if (const Json* closed = optional(s, "closed")) {
@@ -1179,7 +1176,7 @@ private:
         if (!side) {
             if (closed)
                 fail(at, "missing required key (a closed shape needs \"side\": \"in\", \"out\" or \"both\")" +
-                             misspelt_hint(s, "side"));
+                             misspelt_hint(s, {"side"}));
             return Side::Left;
         }
         if (!side->is_string())

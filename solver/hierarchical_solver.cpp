@@ -1400,12 +1400,11 @@ std::pair<double, double> HierarchicalSolver::link_transmittance(int r, int s, E
         return std::make_pair(t.tau, t.error_bound);
     };
     if (nr.cluster() && ns.cluster()) {
-        const uint64_t key = (static_cast<uint64_t>(std::min(nr.hnode, ns.hnode)) << 32) |
-                             static_cast<uint32_t>(std::max(nr.hnode, ns.hnode));
-        // Asked in one order, whichever link asks first: the two orders
-        // may differ in the last bits, and the links must not depend on
-        // which thread got there first.
+        // Keyed and asked in one order, whichever link asks first: the two
+        // orders may differ in the last bits, and the links must not
+        // depend on which thread got there first.
         const int a = std::min(nr.hnode, ns.hnode), b = std::max(nr.hnode, ns.hnode);
+        const uint64_t key = (static_cast<uint64_t>(a) << 32) | static_cast<uint32_t>(b);
         return cached(key, [&](VisibilityStats& mine) {
             return m_vis.transmittance(a, b, skip(a), skip(b), m_vis_eps, GammaRule::Bound, ws, mine);
         });

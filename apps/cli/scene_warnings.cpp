@@ -4,13 +4,9 @@
 
 namespace flatrad {
 
-void print_scene_warnings(std::ostream& err, const Scene& scene) {
-    for (const std::string& line : scene.warnings) err << fmt::format("warning: {}: {}\n", scene.file, line);
-}
-
 Scene load_scene_reporting(const std::string& path, std::ostream& err) {
     Scene scene = load_scene(path);
-    print_scene_warnings(err, scene);
+    for (const std::string& line : scene.warnings) err << fmt::format("warning: {}: {}\n", scene.file, line);
     return scene;
 }
 

@@ -12,6 +12,4 @@ namespace flatrad {
 
 Scene load_scene_reporting(const std::string& path, std::ostream& err);
 
-void print_scene_warnings(std::ostream& err, const Scene& scene);
-
 }  // namespace flatrad
