@@ -1,5 +1,6 @@
 #include "solver/hierarchical_solver.h"
 
+#include <cstdlib>
 #include <omp.h>
 
 #include <Eigen/Dense>
@@ -95,7 +96,7 @@ constexpr size_t min_pieces_to_prove_closed = 32;
 
 // Closure screens (visibility/closure_screen.h, behind_closure_screen): an
 // element's screens lie in closure_screen_bins directions (absolute angles,
-// bins of 1.875 degrees), each at closure_screen_depth times the depth
+// bins of 1.875 degrees), each at closure_screen_depths[0] = 1.05 times the depth
 // from which a shaft is long (MultiscaleVisibility::long_shaft_depth: the
 // proof then walks only the slabs near the element), reaching
 // closure_screen_spread times its depth to each side (the bin's half-width
@@ -103,6 +104,14 @@ constexpr size_t min_pieces_to_prove_closed = 32;
 // element's). One screen per element and bin, asked for by the first target
 // behind it and shown closed or not once: the answer for a target depends
 // only on the element and the target, not on which thread asked first.
+// Since the nineteenth session a bin has screens at several depths
+// (closure_screen_depths, farthest first; the nearer ones' proofs use
+// thinner slabs, multiscale.cpp's screen_min_slab_layers): a target too
+// near for the far screen, or behind a far screen not shown closed, tries
+// the next. On the 10^4 forest at eps 10 (one thread, callgrind) 12.37 G
+// instructions with the one depth, 11.43 G with 1.05 / 0.7 / 0.47, 11.34 G
+// with 0.37 as well (kept), 11.41 G with 1.05 / 0.84 / 0.63 / 0.47 / 0.37;
+// at eps 1 31.2 G against 26.6 G. Nearest first: 11.34 G as well.
 // Measured on the 10^5 forest at eps 10 (`scripts/make-scene 100000 --seed
 // 1 --density 30`; cluster visits, slab proofs and links answered by
 // screens, one run each): none 359 M / 211 007 / 0; 16 bins, 0.41 (wide
@@ -121,7 +130,7 @@ constexpr size_t min_pieces_to_prove_closed = 32;
 // the query it replaced): 700 s against 636 s with this rule (8 200
 // screens answering 814 000 links).
 constexpr int closure_screen_bins = 192;
-constexpr double closure_screen_depth = 1.05;
+constexpr std::array<double, 4> closure_screen_depths = {1.05, 0.7, 0.47, 0.37};
 constexpr double closure_screen_spread = 0.04;
 
 // GMRES stops at ||E - (I - rho G) B|| <= 1e-12 ||E||: the operator is
@@ -429,7 +438,7 @@ public:
         m_vis.set_min_pieces_to_approximate(min_pieces_to_approximate);
         m_vis.set_min_pieces_to_bound(min_pieces_to_bound);
         m_vis.set_min_pieces_to_prove_closed(min_pieces_to_prove_closed);  // (after set_blockers: see there)
-        if (o.closure_screens) m_screen_depth = closure_screen_depth * m_vis.long_shaft_depth();
+        if (o.closure_screens) m_screen_depth = m_vis.long_shaft_depth();
         m_unblockable = std::find(blockers.begin(), blockers.end(), 1) == blockers.end();
         m_kappa = m_vis.layers_per_depth();
         if (m_opt.emission_first && !m_unblockable && m_hierarchy.root() >= 0) {
@@ -565,11 +574,12 @@ private:
     mutable std::unordered_map<uint64_t, TauEntry> m_tau_cache;
     mutable std::shared_mutex m_tau_mutex;
     uint32_t m_wave = 0;  // refinement waves so far (refine, one per wave)
-    // Closure screens (behind_closure_screen): per element node, per
-    // direction bin, 0 not asked yet, 1 shown closed, 2 not shown closed or
-    // not possible there. m_screen_depth: where they stand (infinite: none
-    // are made).
-    mutable std::unordered_map<int, std::array<int8_t, closure_screen_bins>> m_screens;
+    // Closure screens (behind_closure_screen): per element node and depth
+    // (the key: node x the depths' count + the depth's index), per direction
+    // bin, 0 not asked yet, 1 shown closed, 2 not shown closed or not
+    // possible there. m_screen_depth: the unit of closure_screen_depths
+    // (infinite: no screens are made).
+    mutable std::unordered_map<int64_t, std::array<int8_t, closure_screen_bins>> m_screens;
     mutable std::shared_mutex m_screen_mutex;
     double m_screen_depth = std::numeric_limits<double>::infinity();
     // Per hierarchy node: the node whose segments a transmittance from it
@@ -1468,32 +1478,41 @@ bool HierarchicalSolver::behind_closure_screen(int e, const Box& region, ExactWo
     const Node& ne = m_nodes[static_cast<size_t>(e)];
     if (ne.kind != Kind::Element || !std::isfinite(m_screen_depth) || region.empty()) return false;
     const Vec2 m = ne.seg.midpoint(), c = region.center();
-    // The region's nearest point to m is nearer than the screen: no use.
     const Vec2 near{std::clamp(m.x, region.lo.x, region.hi.x), std::clamp(m.y, region.lo.y, region.hi.y)};
-    if (!(distance(near, m) > m_screen_depth)) return false;
     const double bin = 2 * std::numbers::pi / closure_screen_bins;
     const double angle = std::atan2(c.y - m.y, c.x - m.x);  // in [-pi, pi]
     const int k = std::clamp(static_cast<int>(std::floor((angle + std::numbers::pi) / bin)), 0, closure_screen_bins - 1);
     const double centre = -std::numbers::pi + (k + 0.5) * bin;
-    const auto screen = closure_screen(ne.seg, m + Vec2{std::cos(centre), std::sin(centre)}, m_screen_depth,
-                                       closure_screen_spread * m_screen_depth);
-    if (!screen || !screen_covers(*screen, ne.seg, region)) return false;
-    {
-        std::shared_lock lock(m_screen_mutex);
-        const auto it = m_screens.find(e);
-        if (it != m_screens.end() && it->second[static_cast<size_t>(k)] != 0) return it->second[static_cast<size_t>(k)] == 1;
+    for (size_t level = 0; level < closure_screen_depths.size(); ++level) {
+        const double depth = closure_screen_depths[level] * m_screen_depth;
+        // The region's nearest point to m is nearer than the screen: no use.
+        if (!(distance(near, m) > depth)) continue;
+        const auto screen = closure_screen(ne.seg, m + Vec2{std::cos(centre), std::sin(centre)}, depth,
+                                           closure_screen_spread * depth);
+        if (!screen || !screen_covers(*screen, ne.seg, region)) continue;
+        const int64_t key = static_cast<int64_t>(e) * static_cast<int64_t>(closure_screen_depths.size()) +
+                            static_cast<int64_t>(level);
+        {
+            std::shared_lock lock(m_screen_mutex);
+            const auto it = m_screens.find(key);
+            if (it != m_screens.end() && it->second[static_cast<size_t>(k)] != 0) {
+                if (it->second[static_cast<size_t>(k)] == 1) return true;
+                continue;  // not shown closed: a nearer screen may be
+            }
+        }
+        // (Another thread may be proving the same screen: the same answer;
+        // the first to store it counts its work, as link_transmittance does.)
+        VisibilityStats mine;
+        const bool closed = m_vis.shown_closed(ne.seg, m_tau_skip[static_cast<size_t>(ne.hnode)], *screen, ws, mine);
+        std::unique_lock lock(m_screen_mutex);
+        int8_t& known = m_screens[key][static_cast<size_t>(k)];
+        if (known == 0) {
+            known = closed ? 1 : 2;
+            st += mine;
+        }
+        if (closed) return true;
     }
-    // (Another thread may be proving the same screen: the same answer;
-    // the first to store it counts its work, as link_transmittance does.)
-    VisibilityStats mine;
-    const bool closed = m_vis.shown_closed(ne.seg, m_tau_skip[static_cast<size_t>(ne.hnode)], *screen, ws, mine);
-    std::unique_lock lock(m_screen_mutex);
-    int8_t& known = m_screens[e][static_cast<size_t>(k)];
-    if (known == 0) {
-        known = closed ? 1 : 2;
-        st += mine;
-    }
-    return closed;
+    return false;
 }
 
 void HierarchicalSolver::compute_links(LinkVector& links) {

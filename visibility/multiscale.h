@@ -184,9 +184,11 @@ public:
     /// Whether every line from segment a (lit on its left) to segment t
     /// (facing a) is shown blocked by the hierarchy's blockers other than
     /// those of hierarchy node skip_a: a proof from the slabs of a long
-    /// shaft alone (step 0 above), nothing else tried. False when the
-    /// proofs are off, the shaft is not long, or the slabs' bands leave a
-    /// gap. For closure screens (closure_screen.h): counted in
+    /// shaft alone (step 0 above), nothing else tried; the shaft need not
+    /// be long, only deep enough for three slabs of a few layers each
+    /// (thinner than a long shaft's when it is shorter). False when the
+    /// proofs are off, the shaft is not that deep, or the slabs' bands
+    /// leave a gap. For closure screens (closure_screen.h): counted in
     /// stats.queries and stats.slabs as any such proof, and in
     /// stats.screens when shown closed.
     bool shown_closed(const Segment& a, int skip_a, const Segment& t, ExactWorkspace& ws,
