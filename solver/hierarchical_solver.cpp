@@ -109,9 +109,9 @@ constexpr size_t min_pieces_to_prove_closed = 32;
 // thinner slabs, multiscale.cpp's screen_min_slab_layers): a target too
 // near for the far screen, or behind a far screen not shown closed, tries
 // the next. On the 10^4 forest at eps 10 (one thread, callgrind) 12.37 G
-// instructions with the one depth, 11.43 G with 1.05 / 0.7 / 0.47, 11.34 G
+// instructions with the one depth, 11.43 G with 1.05 / 0.7 / 0.47, 11.36 G
 // with 0.37 as well (kept), 11.41 G with 1.05 / 0.84 / 0.63 / 0.47 / 0.37;
-// at eps 1 31.2 G against 26.6 G. Nearest first: 11.34 G as well.
+// at eps 1 31.2 G against 26.6 G. Nearest first: about the same (11.34 G in the trial).
 // Measured on the 10^5 forest at eps 10 (`scripts/make-scene 100000 --seed
 // 1 --density 30`; cluster visits, slab proofs and links answered by
 // screens, one run each): none 359 M / 211 007 / 0; 16 bins, 0.41 (wide

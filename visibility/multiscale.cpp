@@ -57,7 +57,7 @@ constexpr double band_slab_layers = 8;
 // that may close: the proof is exact whatever the slab gives it). On the
 // 10^4 forest (`scripts/make-scene 10000 --seed 1 --density 30`, one
 // thread, callgrind) with screens at 1.05, 0.7, 0.47 and 0.37 long-shaft
-// depths (solver/hierarchical_solver.cpp): 11.34 G instructions at eps 10
+// depths (solver/hierarchical_solver.cpp): 11.36 G instructions at eps 10
 // with 4 layers, 11.43 G with 5 (and only the first three depths usable),
 // 11.30 G with 3 and a fifth screen at 0.29.
 constexpr double screen_min_slab_layers = 4;
