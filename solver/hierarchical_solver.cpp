@@ -1,6 +1,5 @@
 #include "solver/hierarchical_solver.h"
 
-#include <cstdlib>
 #include <omp.h>
 
 #include <Eigen/Dense>
@@ -96,9 +95,9 @@ constexpr size_t min_pieces_to_prove_closed = 32;
 
 // Closure screens (visibility/closure_screen.h, behind_closure_screen): an
 // element's screens lie in closure_screen_bins directions (absolute angles,
-// bins of 1.875 degrees), each at closure_screen_depths[0] = 1.05 times the depth
-// from which a shaft is long (MultiscaleVisibility::long_shaft_depth: the
-// proof then walks only the slabs near the element), reaching
+// bins of 1.875 degrees), the farthest at 1.05 times the depth from which
+// a shaft is long (MultiscaleVisibility::long_shaft_depth: the proof then
+// walks only the slabs near the element), each reaching
 // closure_screen_spread times its depth to each side (the bin's half-width
 // is 0.016 of it; the rest is room for the targets' own width and the
 // element's). One screen per element and bin, asked for by the first target
@@ -111,7 +110,7 @@ constexpr size_t min_pieces_to_prove_closed = 32;
 // the next. On the 10^4 forest at eps 10 (one thread, callgrind) 12.37 G
 // instructions with the one depth, 11.43 G with 1.05 / 0.7 / 0.47, 11.36 G
 // with 0.37 as well (kept), 11.41 G with 1.05 / 0.84 / 0.63 / 0.47 / 0.37;
-// at eps 1 31.2 G against 26.6 G. Nearest first: about the same (11.34 G in the trial).
+// at eps 1 31.2 G against 26.6 G; nearest first about the same (11.34 G).
 // Measured on the 10^5 forest at eps 10 (`scripts/make-scene 100000 --seed
 // 1 --density 30`; cluster visits, slab proofs and links answered by
 // screens, one run each): none 359 M / 211 007 / 0; 16 bins, 0.41 (wide
