@@ -1482,12 +1482,12 @@ bool HierarchicalSolver::behind_closure_screen(int e, const Box& region, ExactWo
     const double angle = std::atan2(c.y - m.y, c.x - m.x);  // in [-pi, pi]
     const int k = std::clamp(static_cast<int>(std::floor((angle + std::numbers::pi) / bin)), 0, closure_screen_bins - 1);
     const double centre = -std::numbers::pi + (k + 0.5) * bin;
+    const Vec2 toward = m + Vec2{std::cos(centre), std::sin(centre)};  // the bin's middle direction
     for (size_t level = 0; level < closure_screen_depths.size(); ++level) {
         const double depth = closure_screen_depths[level] * m_screen_depth;
         // The region's nearest point to m is nearer than the screen: no use.
         if (!(distance(near, m) > depth)) continue;
-        const auto screen = closure_screen(ne.seg, m + Vec2{std::cos(centre), std::sin(centre)}, depth,
-                                           closure_screen_spread * depth);
+        const auto screen = closure_screen(ne.seg, toward, depth, closure_screen_spread * depth);
         if (!screen || !screen_covers(*screen, ne.seg, region)) continue;
         const int64_t key = static_cast<int64_t>(e) * static_cast<int64_t>(closure_screen_depths.size()) +
                             static_cast<int64_t>(level);
