@@ -15,8 +15,11 @@ namespace {
 constexpr int sah_bins = 16;
 }  // namespace
 
-Hierarchy::Hierarchy(const std::vector<Segment>& segments, int leaf_size) : m_segments(segments) {
+Hierarchy::Hierarchy(const std::vector<Segment>& segments, int leaf_size, const std::vector<char>& alone)
+    : m_segments(segments) {
     FLATRAD_ASSERT(leaf_size >= 1, "leaf size must be positive");
+    if (!alone.empty() && alone.size() != segments.size())
+        throw std::invalid_argument("Hierarchy: one 'alone' flag per segment expected");
     const int32_t n = static_cast<int32_t>(segments.size());
     if (n == 0) return;
     m_order.resize(static_cast<size_t>(n));
@@ -42,15 +45,18 @@ Hierarchy::Hierarchy(const std::vector<Segment>& segments, int leaf_size) : m_se
         todo.pop_back();
         ClusterNode nd = m_nodes[static_cast<size_t>(k)];
         Box box, cbox;
+        bool holds_alone = false;  // a segment that must have a leaf of its own
         for (int32_t q = nd.first; q < nd.first + nd.count; ++q) {
             const int32_t s = m_order[static_cast<size_t>(q)];
             box.add(segments[static_cast<size_t>(s)]);
             cbox.add(centroid[static_cast<size_t>(s)]);
+            holds_alone = holds_alone || (!alone.empty() && alone[static_cast<size_t>(s)]);
         }
         nd.box = box;
         m_depth = std::max(m_depth, nd.depth + 1);
         const Vec2 ext = cbox.extent();
-        if (nd.count > leaf_size && (ext.x > 0 || ext.y > 0)) {
+        const bool leaf = nd.count == 1 || (nd.count <= leaf_size && !holds_alone);
+        if (!leaf && (ext.x > 0 || ext.y > 0)) {
             // Split along the longer axis of the centroids' box, at the
             // binned surface-area-heuristic plane (2D: the sum over the two
             // children of box perimeter x count), which separates outliers

@@ -34,8 +34,10 @@ class Hierarchy {
 public:
     Hierarchy() = default;
     /// Builds over `segments` (indices are the caller's segment numbers).
-    /// Leaves hold at most `leaf_size` segments (>= 1).
-    explicit Hierarchy(const std::vector<Segment>& segments, int leaf_size = 2);
+    /// Leaves hold at most `leaf_size` segments (>= 1); a segment flagged
+    /// in `alone` (empty, or one flag per segment) gets a leaf of its own
+    /// (the hierarchical solver's blockers, among walls grouped by 8).
+    explicit Hierarchy(const std::vector<Segment>& segments, int leaf_size = 2, const std::vector<char>& alone = {});
 
     const std::vector<ClusterNode>& nodes() const { return m_nodes; }
     const ClusterNode& node(int k) const { return m_nodes[static_cast<size_t>(k)]; }

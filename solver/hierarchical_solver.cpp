@@ -417,8 +417,8 @@ struct Part {
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
-// The cluster hierarchy's leaf size (the header's "Leaves"): one segment
-// per leaf where any segment can block; where none can,
+// The cluster hierarchy's leaf size for segments that cannot block (the
+// header's "Leaves"; those that can have leaves of their own):
 // options.unblocked_leaf_size, or when that is 0 wide_leaf_size where links
 // are expected to stop well above the leaves. The expectation is a round
 // room's: along a wall of N segments turning by 2 pi / N each, arcs of n
@@ -432,7 +432,6 @@ double seconds_since(Clock::time_point t) { return std::chrono::duration<double>
 constexpr int wide_leaf_size = 8;
 constexpr double wide_leaves_from_arc = 3.0 * wide_leaf_size;
 int leaf_size(const std::vector<char>& blockers, const HierarchicalOptions& options) {
-    if (std::find(blockers.begin(), blockers.end(), 1) != blockers.end()) return 1;
     if (options.unblocked_leaf_size > 0) return options.unblocked_leaf_size;
     const double N = static_cast<double>(blockers.size());
     const double arc = std::cbrt(2 * options.eps * N * N / (std::numbers::pi * std::numbers::pi));
@@ -447,7 +446,7 @@ public:
           m_C(scene.channels),
           m_facts(std::async(std::launch::async, scene_facts, std::cref(scene))),
           m_blockers(possible_blockers(scene)),
-          m_hierarchy(scene.segment_geometry(), leaf_size(m_blockers, o)),
+          m_hierarchy(scene.segment_geometry(), leaf_size(m_blockers, o), m_blockers),
           m_tables(m_hierarchy),
           m_vis(m_hierarchy, m_tables),
           m_obox(oriented_boxes(m_hierarchy)) {
@@ -582,7 +581,8 @@ private:
     bool m_convex_room = false;
 
     // Which segments can block (engine/convex_scene.h), before the
-    // hierarchy: its leaf size depends on whether any can (leaf_size).
+    // hierarchy: those have leaves of their own, the others may share
+    // (leaf_size).
     std::vector<char> m_blockers;
     Hierarchy m_hierarchy;
     ClusterTables m_tables;
@@ -986,7 +986,12 @@ void HierarchicalSolver::self_occlusion() {
         double* beta = &m_beta[static_cast<size_t>(n.table) * K];
         for (int b = 0; b < K; ++b) {
             const double target = a[b] * m_sensitivity_all[static_cast<size_t>(n.table) * TW + static_cast<size_t>(b)];
-            beta[b] = sum[b] > 0 ? std::min(1.0, target / sum[b]) : 1.0;
+            // Nothing hidden inside this cluster (A = 1): its children's
+            // sum is at most its lobes' (equal but for rounding when none
+            // is hidden either: a leaf's sides summed in another order), so
+            // beta is 1 exactly, not 1 - 1e-16, which would mark the table
+            // hidden and keep every link from reading its linear part.
+            beta[b] = a[b] < 1 && sum[b] > 0 ? std::min(1.0, target / sum[b]) : 1.0;
             S[b] = beta[b] * sum[b];
             hidden = hidden || beta[b] < 1;
         }

@@ -9,17 +9,19 @@
 ///    Sinks that no patch can see get no node (solver/sink_visibility.h).
 ///    Leaves: one segment per hierarchy leaf serves visibility (queries
 ///    walk the hierarchy; a forest of 10^4 sticks with 8 per leaf made 4.4
-///    times the links). Where nothing can block (a convex room) there is
-///    no query to serve, and small clusters only cost their tables and
-///    nodes: a round room of 10^6 walls peaked at 2.6 GB with one per
-///    leaf, 1.3 GB with 8, for the same links and solution to 5e-9 (this
-///    machine backs each run's fresh memory afresh: 10.3 s from start to
-///    result against 6.9 s). But a link that reaches a leaf splits into
-///    all its sides at once, so where links go that deep wide leaves
-///    multiply them (1000 walls at eps 3e-3: 30 615 links with one per
-///    leaf, 102 605 with 8). So leaves hold up to 8 segments only where
-///    nothing blocks and links are expected to stop at arcs of 24 walls
-///    or more (HierarchicalOptions::unblocked_leaf_size).
+///    times the links), so a segment that can block has a leaf of its
+///    own. Segments that cannot (walls on the scene's hull,
+///    engine/convex_scene.h) serve no query, and as small clusters they
+///    only cost tables and nodes: they share leaves of up to 8 where links
+///    are expected to stop well above the leaves (many walls, a loose eps:
+///    HierarchicalOptions::unblocked_leaf_size). A round room of 10^6 walls
+///    peaked at 2.6 GB with one per leaf, 1.3 GB with 8, for the same links
+///    and solution to 5e-9 (this machine backs each run's fresh memory
+///    afresh: 10.3 s from start to result against 7.3 s); with a lamp
+///    inside, 3.4 GB and 16.7 s against 1.7 GB and 11.7 s. But a link
+///    that reaches a leaf splits into all its sides at once, so where links
+///    go that deep wide leaves multiply them (1000 walls at eps 3e-3:
+///    30 615 links with one per leaf, 102 605 with 8).
 ///  - Links between any two nodes, created top-down: the root's self link
 ///    is split into its children's pairs and self links, and so on; a link
 ///    to a hierarchy leaf goes to its sides. A link (receiver r, sender s):
@@ -206,12 +208,12 @@ struct HierarchicalOptions {
     /// same links whichever way the operator is split into parts, as the
     /// loose solves of parts apart and together stop at different points).
     bool loose_intermediate_solves = true;
-    /// Where nothing can block (every segment on the scene's hull, as in a
-    /// convex room: engine/convex_scene.h), the cluster hierarchy's leaves
-    /// may hold several segments ("Leaves" above): this many (>= 1), or
-    /// with 0 (the default) 8 where links are expected to stop far above
-    /// the leaves (many walls, loose eps: the .cpp's leaf_size), else 1.
-    /// Blocked scenes keep one per leaf whatever it says.
+    /// Segments that cannot block (on the scene's hull: engine/
+    /// convex_scene.h) may share the cluster hierarchy's leaves ("Leaves"
+    /// above): up to this many (>= 1), or with 0 (the default) 8 where
+    /// links are expected to stop far above the leaves (many walls, loose
+    /// eps: the .cpp's leaf_size), else 1. A segment that can block always
+    /// has a leaf of its own.
     int unblocked_leaf_size = 0;
     /// Called now and then from the solving thread with what is being done
     /// ("refine pass 2", "solve", ...) and a fraction in [0, 1] of the whole

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <random>
 #include <set>
+#include <stdexcept>
 
 using namespace flatrad;
 
@@ -160,4 +161,31 @@ TEST_CASE("hierarchy: set_blockers counts per node, and query_blockers walks onl
         CHECK(visited <= all);
     }
     CHECK_THROWS(h.set_blockers(std::vector<char>(3, 1)));
+}
+
+TEST_CASE("hierarchy: segments flagged alone get leaves of their own, the others share up to the leaf size") {
+    std::mt19937_64 rng(11);
+    for (int n : {2, 9, 1000}) {
+        const auto segs = random_segments(rng, n);
+        std::vector<char> alone(static_cast<size_t>(n), 0);
+        for (int s = 0; s < n; s += 7) alone[static_cast<size_t>(s)] = 1;  // every seventh
+        const Hierarchy h(segs, 8, alone);
+        std::vector<int> seen(static_cast<size_t>(n), 0);
+        long shared = 0;  // leaves holding more than one segment
+        for (const ClusterNode& nd : h.nodes()) {
+            if (!nd.leaf()) continue;
+            CHECK(nd.count <= 8);
+            shared += nd.count > 1;
+            for (int k = nd.first; k < nd.first + nd.count; ++k) {
+                const int s = h.order()[static_cast<size_t>(k)];
+                ++seen[static_cast<size_t>(s)];
+                CAPTURE(s);
+                if (alone[static_cast<size_t>(s)]) CHECK(nd.count == 1);
+            }
+        }
+        for (int c : seen) CHECK(c == 1);
+        CAPTURE(n);
+        if (n >= 9) CHECK(shared > 0);  // the flags did not force single leaves everywhere
+    }
+    CHECK_THROWS_AS(Hierarchy(random_segments(rng, 3), 8, std::vector<char>(2, 0)), std::invalid_argument);
 }
