@@ -2,8 +2,8 @@
 /// Hierarchical radiosity with clustering (DESIGN.md §3; Hanrahan, Salzman,
 /// Aupperle 1991; Smits, Arvo, Greenberg 1994; Sillion 1995).
 ///
-///  - One tree: the scene's cluster hierarchy (engine/hierarchy.h, one
-///    segment per leaf), under each leaf the two sides of its segment (a
+///  - One tree: the scene's cluster hierarchy (engine/hierarchy.h; leaves
+///    below), under each leaf the two sides of each of its segments (a
 ///    patch, the root of a binary element tree, or a sink: an unlit side,
 ///    black, receive-only), elements split at their middle on demand.
 ///    Sinks that no patch can see get no node (solver/sink_visibility.h).
