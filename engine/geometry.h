@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 namespace flatrad {
 
@@ -89,5 +90,22 @@ struct Box {
     Vec2 extent() const { return hi - lo; }
     double diagonal() const { return empty() ? 0.0 : norm(hi - lo); }
 };
+
+/// Whether the segment from p to q meets the closed box b (clipping the
+/// segment's parameter range to each axis' slab, Liang and Barsky 1984; an
+/// axis along which the segment does not move needs p within the slab).
+inline bool segment_meets_box(Vec2 p, Vec2 q, const Box& b) {
+    if (b.empty()) return false;
+    double t0 = 0, t1 = 1;
+    auto clip = [&](double p0, double d, double lo, double hi) {
+        if (d == 0) return p0 >= lo && p0 <= hi;
+        double ta = (lo - p0) / d, tb = (hi - p0) / d;
+        if (ta > tb) std::swap(ta, tb);
+        t0 = std::max(t0, ta);
+        t1 = std::min(t1, tb);
+        return t0 <= t1;
+    };
+    return clip(p.x, q.x - p.x, b.lo.x, b.hi.x) && clip(p.y, q.y - p.y, b.lo.y, b.hi.y);
+}
 
 }  // namespace flatrad

@@ -208,6 +208,12 @@ struct HierarchicalOptions {
     /// same links whichever way the operator is split into parts, as the
     /// loose solves of parts apart and together stop at different points).
     bool loose_intermediate_solves = true;
+    /// In scenes with at most 64 segments that may block, a link whose
+    /// shaft none of them can reach (checked one by one against a capsule
+    /// around the link) takes the unoccluded exchange without asking the
+    /// visibility module, which would find the shaft empty (the same
+    /// answer); off: every such link asks (for tests: the oracle).
+    bool clear_shaft_shortcut = true;
     /// Segments that cannot block (on the scene's hull: engine/
     /// convex_scene.h) may share the cluster hierarchy's leaves ("Leaves"
     /// above): up to this many (>= 1), or with 0 (the default) 8 where
