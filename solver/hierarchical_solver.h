@@ -18,10 +18,11 @@
 ///    peaked at 2.6 GB with one per leaf, 1.3 GB with 8, for the same links
 ///    and solution to 5e-9 (this machine backs each run's fresh memory
 ///    afresh: 10.3 s from start to result against 7.3 s); with a lamp
-///    inside, 3.4 GB and 16.7 s against 1.7 GB and 11.7 s. But a link
-///    that reaches a leaf splits into all its sides at once, so where links
-///    go that deep wide leaves multiply them (1000 walls at eps 3e-3:
-///    30 615 links with one per leaf, 102 605 with 8).
+///    inside, 3.4 GB and 16.7 s against 1.7 GB and 11.7 s (8.2 s once
+///    links the lamp cannot reach ask nothing: clear_shaft_shortcut). But
+///    a link that reaches a leaf splits into all its sides at once, so
+///    where links go that deep wide leaves multiply them (1000 walls at
+///    eps 3e-3: 30 615 links with one per leaf, 102 605 with 8).
 ///  - Links between any two nodes, created top-down: the root's self link
 ///    is split into its children's pairs and self links, and so on; a link
 ///    to a hierarchy leaf goes to its sides. A link (receiver r, sender s):
