@@ -4,33 +4,16 @@
 // for far fewer queries.
 #include <doctest/doctest.h>
 
-#include <cmath>
 #include <fmt/format.h>
-#include <numbers>
 #include <string>
 
 #include "engine/scene.h"
 #include "solver/hierarchical_solver.h"
+#include "support/ring_scene.h"
 
 using namespace flatrad;
 
 namespace {
-
-// A round room of n walls with a lamp inside, lit on both sides: the one
-// segment that can block.
-Scene ring_with_lamp(int n) {
-    std::string wall;
-    for (int k = 0; k <= n; ++k) {
-        const double t = 2 * std::numbers::pi * (k % n) / n;
-        wall += fmt::format("{}[{:.17g},{:.17g}]", k ? "," : "", std::cos(t), std::sin(t));
-    }
-    return parse_scene(fmt::format(R"({{"flatrad": 1, "name": "ring",
-        "materials": {{"w": {{"reflectance": 0.7}}, "l": {{"reflectance": 0.5, "emission": 1}}}},
-        "surfaces": [{{"name": "lamp", "material": "l", "side": "both", "points": [[-0.05, 0.5], [0.05, 0.5]]}},
-                     {{"name": "wall", "material": "w", "side": "left", "points": [{}]}}]}})",
-                                   wall),
-                       "ring.json");
-}
 
 // Solves with and without the shortcut; checks that the two agree bit for
 // bit and returns {queries with, queries without}.
@@ -53,7 +36,7 @@ std::pair<long, long> compare(const Scene& scene) {
 TEST_CASE("clear shafts: a round room with a lamp inside asks only the lamp's shadows") {
     // Measured at 10^5 walls: 45 765 queries against 427 863, 387 569 of
     // which found their shaft empty. Bar: at most a quarter here.
-    const auto [with, without] = compare(ring_with_lamp(3000));
+    const auto [with, without] = compare(flatrad::test::ring_scene(3000, 0.7, 0, true));
     MESSAGE("3000-wall ring with a lamp inside: ", with, " queries with the shortcut, ", without, " without");
     CHECK(with > 0);  // the lamp's shadows are still asked
     CHECK(4 * with <= without);

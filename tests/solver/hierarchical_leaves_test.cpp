@@ -7,39 +7,19 @@
 
 #include <cmath>
 #include <fmt/format.h>
-#include <numbers>
 #include <string>
 
 #include "engine/error.h"
 #include "solver/exact_solver.h"
 #include "solver/hierarchical_solver.h"
 #include "support/relative_l2.h"
+#include "support/ring_scene.h"
 
 using namespace flatrad;
 using flatrad::test::relative_l2;
+using flatrad::test::ring_scene;
 
 namespace {
-
-// A round room of n walls, one of them the lamp: every segment is on the
-// hull, so nothing can block (engine/convex_scene.h).
-Scene ring(int n, double rho, double wall_emission, bool lamp_inside = false) {
-    auto point = [n](int k) {
-        const double t = 2 * std::numbers::pi * (k % n) / n;
-        return fmt::format("[{:.17g},{:.17g}]", std::cos(t), std::sin(t));
-    };
-    std::string wall = point(1);
-    for (int k = 2; k <= n; ++k) wall += "," + point(k);
-    // Inside: a lamp lit on both sides across the room, the one segment
-    // that can block; else the lamp is one of the walls.
-    const std::string lamp = lamp_inside ? R"("side": "both", "points": [[-0.05, 0.5], [0.05, 0.5]])"
-                                         : fmt::format(R"("side": "left", "points": [{},{}])", point(0), point(1));
-    return parse_scene(fmt::format(R"({{"flatrad": 1, "name": "ring",
-        "materials": {{"w": {{"reflectance": {}, "emission": {}}}, "l": {{"reflectance": {}, "emission": 1}}}},
-        "surfaces": [{{"name": "lamp", "material": "l", {}}},
-                     {{"name": "wall", "material": "w", "side": "left", "points": [{}]}}]}})",
-                                   rho, wall_emission, rho, lamp, lamp_inside ? point(0) + "," + wall : wall),
-                       "ring.json");
-}
 
 HierarchicalOptions leaves(int k) {
     HierarchicalOptions o;
@@ -58,7 +38,7 @@ TEST_CASE("hierarchy leaves: eight walls per leaf in a round room, against exact
     // so at most a quarter of them (measured: an eighth).
     constexpr double same_error_ratio = 1.25;
     constexpr double l2_bar = 3e-3;
-    const Scene room = ring(2000, 0.7, 0);
+    const Scene room = ring_scene(2000, 0.7, 0);
     const Solution one = solve_hierarchical(room, leaves(1));
     const Solution eight = solve_hierarchical(room, leaves(8));
     const Solution exact = solve_exact(room, {1, 0});
@@ -81,7 +61,7 @@ TEST_CASE("hierarchy leaves: the white furnace holds with eight walls per leaf")
     constexpr double furnace_tol = 1e-6;
     HierarchicalOptions o = leaves(8);
     o.eps = 1e-2;
-    const Solution w = solve_hierarchical(ring(3000, 0.999, 1), o);
+    const Solution w = solve_hierarchical(ring_scene(3000, 0.999, 1), o);
     double worst = 0;
     for (const PatchResult& pr : w.patches) worst = std::max(worst, std::abs(pr.radiosity[0] - 1000.0) / 1000.0);
     MESSAGE("3000-wall white furnace, 8 walls per leaf: worst ", worst, " in ", w.stats.iterations, " iterations");
@@ -95,7 +75,7 @@ TEST_CASE("hierarchy leaves: the default widens them only where links stop far a
     // one per leaf's tables; the solutions agree within twice the default
     // eps's L2 bar (each is within it of the exact answer).
     constexpr double l2_bar = 3e-3;
-    const Scene big = ring(10000, 0.5, 0);
+    const Scene big = ring_scene(10000, 0.5, 0);
     const Solution by_default = solve_hierarchical(big);
     const Solution one = solve_hierarchical(big, leaves(1));
     const double diff = relative_l2(big, by_default, one);
@@ -106,7 +86,7 @@ TEST_CASE("hierarchy leaves: the default widens them only where links stop far a
     // Fewer walls, or a tighter eps (links down to arcs of ~13 walls at
     // 10^4 and 1e-4; ~5 at 500 and 3e-3): one per leaf, the same solution
     // bit for bit.
-    const Scene small = ring(500, 0.5, 0);
+    const Scene small = ring_scene(500, 0.5, 0);
     const Solution a = solve_hierarchical(small), b = solve_hierarchical(small, leaves(1));
     CHECK(a.stats.cluster_tables == b.stats.cluster_tables);
     CHECK(a.stats.links == b.stats.links);
@@ -128,7 +108,7 @@ TEST_CASE("hierarchy leaves: walls share leaves beside a blocker, which keeps it
     // 3e-3.
     constexpr double same_error_ratio = 1.25;
     constexpr double l2_bar = 3e-3;
-    const Scene room = ring(2000, 0.7, 0, true);
+    const Scene room = ring_scene(2000, 0.7, 0, true);
     const Solution one = solve_hierarchical(room, leaves(1));
     const Solution eight = solve_hierarchical(room, leaves(8));
     const Solution exact = solve_exact(room, {1, 0});
@@ -149,7 +129,7 @@ TEST_CASE("hierarchy leaves: walls share leaves beside a blocker, which keeps it
     // from view (self-occlusion) and kept their links from the tables'
     // linear parts: 5.4x the links here, 12x at 10^5 walls. Bar 2x.
     constexpr double same_links_ratio = 2;
-    const Scene big = ring(10000, 0.7, 0, true);
+    const Scene big = ring_scene(10000, 0.7, 0, true);
     const Solution wide = solve_hierarchical(big), narrow = solve_hierarchical(big, leaves(1));
     const double diff = relative_l2(big, wide, narrow);
     MESSAGE("10^4-wall ring, lamp inside: ", wide.stats.links, " links by default (", wide.stats.cluster_tables,

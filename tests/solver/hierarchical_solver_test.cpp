@@ -3,6 +3,7 @@
 // balance, refusal of a closed reflectance-1 room.
 #include "solver/hierarchical_solver.h"
 #include "support/relative_l2.h"
+#include "support/ring_scene.h"
 
 #include <doctest/doctest.h>
 
@@ -338,20 +339,7 @@ TEST_CASE("hierarchical solver: chain links along a round room: fewer links, the
     // A round room whose walls are one convex loop and whose lamp is one
     // of them: neighbouring arcs exchange their exact etendue as chain
     // links (see the header) instead of being split down to the walls.
-    auto ring = [](int n, double rho, const char* lamp_emission) {
-        auto point = [n](int k) {
-            const double t = 2 * std::numbers::pi * (k % n) / n;
-            return fmt::format("[{:.17g},{:.17g}]", std::cos(t), std::sin(t));
-        };
-        std::string wall = point(1);
-        for (int k = 2; k <= n; ++k) wall += "," + point(k);
-        return parse_scene(fmt::format(R"({{"flatrad": 1, "name": "ring",
-            "materials": {{"w": {{"reflectance": {}, "emission": {}}}, "l": {{"reflectance": {}, "emission": 1}}}},
-            "surfaces": [{{"name": "lamp", "material": "l", "side": "left", "points": [{},{}]}},
-                         {{"name": "wall", "material": "w", "side": "left", "points": [{}]}}]}})",
-                                       rho, lamp_emission, rho, point(0), point(1), wall),
-                           "ring.json");
-    };
+    // (tests/support/ring_scene.h: the lamp is one of the walls.)
     // Against exact (K = 1: the walls are the elements, ~1e-8 of mesh
     // error at 2000 walls by `flatrad compare`), with and without chain
     // links. Measured at 2000 walls, eps 3e-3: the errors agree to 3
@@ -360,7 +348,7 @@ TEST_CASE("hierarchical solver: chain links along a round room: fewer links, the
     // 3e-3 (the default eps's bar), and at least a fifth fewer links.
     constexpr double same_error_ratio = 1.25;
     constexpr double l2_bar = 3e-3;
-    const Scene room = ring(2000, 0.7, "0");
+    const Scene room = test::ring_scene(2000, 0.7, 0);
     HierarchicalOptions with, without;
     without.chain_links = false;
     const Solution c = solve_hierarchical(room, with);
@@ -382,7 +370,7 @@ TEST_CASE("hierarchical solver: chain links along a round room: fewer links, the
     // White furnace through chain links: every wall emits 1 at reflectance
     // 0.999, so B = 1000 everywhere to the issue's 1e-6.
     constexpr double furnace_tol = 1e-6;
-    const Scene furnace = ring(3000, 0.999, "1");
+    const Scene furnace = test::ring_scene(3000, 0.999, 1);
     HierarchicalOptions f;
     f.eps = 1e-2;
     const Solution w = solve_hierarchical(furnace, f);
