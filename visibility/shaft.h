@@ -134,6 +134,40 @@ struct Shaft {
 // `size` (the shaft's diagonal) is no longer used: tolerances are local.
 inline bool add_blocker(const Shaft& shaft, const Segment& s, [[maybe_unused]] double size,
                         std::vector<Segment>& blockers) {
+    const auto magnitude = [](Vec2 v) { return std::max(std::abs(v.x), std::abs(v.y)); };
+    // On the inner side of edge e's line by more than `bar`, in plain
+    // arithmetic: dot(n, x - p), as orient(p, q, x) computes it but with
+    // every product rounded, so within culling_slack |n|_1 (|x| + |p| +
+    // |q|) of the exact value (see culling_slack).
+    const auto clearly_inside = [&](size_t e, Vec2 x, double bar) {
+        const Vec2 n = shaft.normal[e], p = shaft.v[e];
+        return n.x * (x.x - p.x) + n.y * (x.y - p.y) > bar;
+    };
+    // The margins: for the side edges (1, 3) the rounding above, so that
+    // orient is >= 0 (Cyrus-Beck keeps the whole segment, cut by no edge);
+    // for the patches' edges (0, 2) on_line's plain bound below, past which
+    // an end is surely off the patch's line (it also exceeds the rounding).
+    const auto bar = [&](size_t e, double mx) {
+        const double slack = culling_slack * (mx + shaft.ends[e]);
+        if (e % 2 == 1) return slack * shaft.normal_l1[e];
+        return (on_edge_tolerance * 4 * std::max(mx, shaft.ends[e]) + slack) * shaft.normal_l1[e];
+    };
+    // Wholly and clearly inside the shaft (most pieces of a long shaft
+    // through a forest): the exact path below would keep s whole, find
+    // neither end on a patch's line and no edge cutting it, so s itself is
+    // the piece, bit for bit, without the exact orientations. (A
+    // zero-length edge has a zero normal: the test fails, the exact path
+    // decides.)
+    if (!(s.a == s.b)) {
+        const double ma = magnitude(s.a), mb = magnitude(s.b);
+        bool inside = true;
+        for (size_t e = 0; e < 4 && inside; ++e)
+            inside = clearly_inside(e, s.a, bar(e, ma)) && clearly_inside(e, s.b, bar(e, mb));
+        if (inside) {
+            blockers.push_back(s);
+            return false;
+        }
+    }
     Segment piece;
     int enter = -1, leave = -1;
     if (!shaft.clip(s, piece, enter, leave)) return false;
@@ -141,7 +175,6 @@ inline bool add_blocker(const Shaft& shaft, const Segment& s, [[maybe_unused]] d
     // whether either end touches a patch's line. The distance of x to the
     // line is measured from the patch's nearer end (orient(p, q, x) is
     // |q - p| times that distance; from q it is -orient(q, p, x)).
-    const auto magnitude = [](Vec2 v) { return std::max(std::abs(v.x), std::abs(v.y)); };
     const auto on_line = [&](size_t e, Vec2 p, Vec2 q, Vec2 x) {
         // Clearly off the line first, in plain arithmetic: the test below
         // is o <= tol local |pq| with local <= 4 max(|x|, |p|, |q|) (max
@@ -152,9 +185,8 @@ inline bool add_blocker(const Shaft& shaft, const Segment& s, [[maybe_unused]] d
         {
             const Vec2 n = shaft.normal[e];
             const double fast = n.x * (x.x - p.x) + n.y * (x.y - p.y);
-            const double mx = magnitude(x), m = std::max(mx, shaft.ends[e]);
-            if (fast > (on_edge_tolerance * 4 * m + culling_slack * (mx + shaft.ends[e])) * shaft.normal_l1[e])
-                return false;
+            const double mx = magnitude(x);
+            if (fast > bar(e, mx)) return false;
         }
         const bool from_p = distance(x, p) <= distance(x, q);
         const Vec2 near = from_p ? p : q;

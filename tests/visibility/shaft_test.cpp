@@ -3,9 +3,11 @@
 //   - Shaft::overlaps may say "overlaps" for a box that does not (it is a
 //     filter: a node visited for nothing), never "disjoint" for one that
 //     does; and it must still cull what is clearly outside.
-//   - add_blocker's plain-arithmetic shortcut for "clearly off a patch's
-//     line" must give the same pieces as the exact test alone, also for
-//     pieces placed at the tolerance's edge and at extreme coordinates.
+//   - add_blocker's plain-arithmetic shortcuts for "clearly off a patch's
+//     line" and "wholly and clearly inside the shaft" must give the same
+//     pieces as the exact tests alone, also for pieces placed at the
+//     tolerance's edge, a hair inside or outside an edge, and at extreme
+//     coordinates.
 #include "visibility/shaft.h"
 
 #include <doctest/doctest.h>
@@ -263,4 +265,51 @@ TEST_CASE("shaft: add_blocker's shortcut gives the exact test's pieces, at the t
     }
     CHECK(compared == 4 * 200 * 40);
     CHECK(dropped_on_line > 100);  // the edge cases were reached: pieces along the patch dropped
+}
+
+TEST_CASE("shaft: add_blocker's inside shortcut gives the exact test's pieces, a hair from every edge") {
+    // Segments with one end well inside and the other a few roundings (of
+    // the coordinates' magnitude) from one of the four edges' lines, on
+    // either side, or on it: where the plain products cannot tell the side,
+    // the shortcut must leave the piece to the exact clip.
+    std::mt19937_64 rng(13);
+    std::uniform_real_distribution<double> u(-1, 1);
+    long compared = 0, whole = 0, cut = 0;
+    for (const auto& [scale, offset] : {std::pair{1.0, Vec2{0, 0}}, std::pair{1.0, Vec2{5e14, 5e14}},
+                                        std::pair{1e-4, Vec2{0, 0}}, std::pair{1e8, Vec2{-1e8, 0}}}) {
+        const double local = scale + std::abs(offset.x) + std::abs(offset.y);
+        for (int t = 0; t < 200; ++t) {
+            const Pair pr = random_pair(rng, scale, offset);
+            const Shaft s(pr.i, pr.j);
+            const Vec2 centre = 0.25 * (s.v[0] + s.v[1] + s.v[2] + s.v[3]);
+            for (size_t e = 0; e < 4; ++e) {
+                const Vec2 p = s.v[e], q = s.v[(e + 1) % 4];
+                const Vec2 inward = rot90(q - p) / norm(q - p);  // the shaft is counter-clockwise: inside is left
+                for (int k = 0; k < 12; ++k) {
+                    // A point on the edge's line, moved across it by a few
+                    // ulps to a few thousand of the local magnitude.
+                    const double ulps = std::ldexp(1.0, static_cast<int>(std::floor(12 * std::abs(u(rng)))));
+                    const double off = u(rng) * ulps * std::numeric_limits<double>::epsilon() * local;
+                    const Vec2 near = lerp(p, q, 0.5 + 0.45 * u(rng)) + off * inward;
+                    const Vec2 far = lerp(centre, near, 0.3 + 0.3 * std::abs(u(rng)));
+                    const Segment b = k % 2 ? Segment{near, far} : Segment{far, near};
+                    std::vector<Segment> fast, oracle;
+                    const bool fast_closes = shaft_detail::add_blocker(s, b, 0, fast);
+                    const bool oracle_closes = add_blocker_oracle(s, b, oracle);
+                    CHECK(fast_closes == oracle_closes);
+                    REQUIRE(fast.size() == oracle.size());
+                    if (!fast.empty()) {
+                        CHECK(fast[0].a == oracle[0].a);
+                        CHECK(fast[0].b == oracle[0].b);
+                        ++(fast[0].a == b.a && fast[0].b == b.b ? whole : cut);
+                    }
+                    ++compared;
+                }
+            }
+        }
+    }
+    CHECK(compared == 4 * 200 * 4 * 12);
+    // Both outcomes were reached: pieces kept whole and pieces cut at the edge.
+    CHECK(whole > 1000);
+    CHECK(cut > 100);
 }
