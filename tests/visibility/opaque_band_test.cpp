@@ -285,3 +285,70 @@ TEST_CASE("opaque band: nothing to show, or nothing finite: not closed") {
     const Segment far{{-huge, 0}, {huge, 0}};
     CHECK_FALSE(band_closes_shaft(far, b.j, b.sticks.data(), b.sticks.size(), scratch));
 }
+
+namespace {
+
+// gaps_in_window's oracle: sort by start, sweep once (the section check as
+// it was).
+double gaps_by_sorting(OffsetInterval window, std::vector<OffsetInterval> shadows, double budget) {
+    std::sort(shadows.begin(), shadows.end(), [](const OffsetInterval& x, const OffsetInterval& y) { return x.a < y.a; });
+    double reach = window.a, free = 0;
+    for (const OffsetInterval& sh : shadows) {
+        if (sh.a > reach) {
+            free += sh.a - reach;
+            if (free > budget) return free;
+        }
+        reach = std::max(reach, sh.b);
+        if (reach >= window.b) return free;
+    }
+    return free + (window.b - reach);
+}
+
+}  // namespace
+
+TEST_CASE("opaque band: a section's gaps summed by hops are the sorted sweep's, bit for bit") {
+    // Windows covered many times over (a band's usual section: a few hops),
+    // sparse ones (many gaps: the sweep takes over past the hop budget),
+    // shadows sharing ends, starting before the window or running past it,
+    // and budgets that stop the sum part way.
+    std::mt19937_64 rng(17);
+    std::uniform_real_distribution<double> u(0, 1);
+    long compared = 0, covered = 0, stopped = 0, many_gaps = 0;
+    for (int t = 0; t < 20000; ++t) {
+        const double scale = std::ldexp(1.0, static_cast<int>(60 * u(rng)) - 30);
+        const OffsetInterval window{-scale * u(rng), scale * (1 + u(rng))};
+        const double width = window.b - window.a;
+        const int m = 1 + static_cast<int>(80 * u(rng));
+        const double mean_length = width * (t % 3 == 0 ? 0.02 : t % 3 == 1 ? 0.2 : 0.6) * (0.5 + u(rng));
+        std::vector<OffsetInterval> shadows;
+        for (int k = 0; k < m; ++k) {
+            const double a = window.a - 0.2 * width + 1.4 * width * u(rng);
+            OffsetInterval sh{a, a + mean_length * (0.1 + u(rng))};
+            if (!shadows.empty() && u(rng) < 0.1) sh.a = shadows.back().b;  // abutting: no gap between them
+            if (sh.b > sh.a && sh.b > window.a && sh.a < window.b) shadows.push_back(sh);
+        }
+        const double budget = t % 4 == 0 ? std::numeric_limits<double>::infinity() : width * 0.3 * u(rng);
+        std::vector<OffsetInterval> work = shadows;
+        const double by_hops = gaps_in_window(window, work.data(), work.size(), budget);
+        const double by_sorting = gaps_by_sorting(window, shadows, budget);
+        CHECK(by_hops == by_sorting);
+        covered += by_sorting == 0;
+        stopped += by_sorting > budget;
+        // Gaps in the union over the window, counted by the oracle's order.
+        std::sort(shadows.begin(), shadows.end(), [](const OffsetInterval& x, const OffsetInterval& y) { return x.a < y.a; });
+        int gaps = 0;
+        double reach = window.a;
+        for (const OffsetInterval& sh : shadows) {
+            gaps += sh.a > reach;
+            reach = std::max(reach, sh.b);
+        }
+        many_gaps += gaps > 12;
+        ++compared;
+    }
+    CHECK(compared == 20000);
+    // Each regime was reached: windows wholly covered, sums stopped by the
+    // budget, and more gaps than hops (the sweep's part).
+    CHECK(covered > 1000);
+    CHECK(stopped > 1000);
+    CHECK(many_gaps > 1000);
+}
