@@ -70,6 +70,11 @@ struct OpaqueBandScratch {
         size_t piece;
     };
     std::vector<Depth> by_depth;
+    /// by_depth's buckets of depth: bucket b holds places [depth_first[b],
+    /// depth_first[b + 1]), sorted once depth_sorted[b] (band_bound).
+    std::vector<size_t> depth_first, depth_fill;
+    std::vector<char> depth_sorted;
+    std::vector<double> depth_mid;
     std::vector<Vec2> run_ends;     // the bands' pieces' ends, band after band (Band::ends_first)
     std::vector<Band> bands;
     std::vector<Vec2> points;
@@ -153,6 +158,10 @@ struct BandOptions {
     /// the first built first, each within the slab between the patches;
     /// null: evenly spaced (band_depth), the middle one first.
     const double* depths = nullptr;
+    /// Pieces per bucket of depth when finding the bands' runs (see
+    /// band_bound's .cpp): any value gives the same answer, bit for bit;
+    /// SIZE_MAX sorts all the pieces at once (for tests: the oracle).
+    size_t depth_bucket = 16;
 };
 
 /// Depth of band k (0 first) with evenly spaced bands between xi and xj:
