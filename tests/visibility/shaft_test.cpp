@@ -16,6 +16,7 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <utility>
 #include <vector>
 
 using namespace flatrad;
@@ -86,6 +87,22 @@ bool add_blocker_oracle(const Shaft& shaft, const Segment& s, std::vector<Segmen
     if (!end_on_patch_line && ((enter == 1 && leave == 3) || (enter == 3 && leave == 1))) return true;
     blockers.push_back(piece);
     return false;
+}
+
+// add_blocker against its oracle on one segment: the same verdict and the
+// same piece, bit for bit. Returns the oracle's pieces (none or one) and
+// whether it closes the shaft.
+std::pair<std::vector<Segment>, bool> check_against_oracle(const Shaft& s, const Segment& b) {
+    std::vector<Segment> fast, oracle;
+    const bool fast_closes = shaft_detail::add_blocker(s, b, 0, fast);
+    const bool oracle_closes = add_blocker_oracle(s, b, oracle);
+    CHECK(fast_closes == oracle_closes);
+    REQUIRE(fast.size() == oracle.size());
+    if (!fast.empty()) {
+        CHECK(fast[0].a == oracle[0].a);
+        CHECK(fast[0].b == oracle[0].b);
+    }
+    return {oracle, oracle_closes};
 }
 
 // A facing pair lit on the left: i along y = 0 (lit upward), j above it
@@ -249,15 +266,7 @@ TEST_CASE("shaft: add_blocker's shortcut gives the exact test's pieces, at the t
                     b = {offset + scale * Vec2{1.5 * u(rng), 1 + 1.2 * u(rng)},
                          offset + scale * Vec2{1.5 * u(rng), 1 + 1.2 * u(rng)}};
                 }
-                std::vector<Segment> fast, oracle;
-                const bool fast_closes = shaft_detail::add_blocker(s, b, 0, fast);
-                const bool oracle_closes = add_blocker_oracle(s, b, oracle);
-                CHECK(fast_closes == oracle_closes);
-                REQUIRE(fast.size() == oracle.size());
-                if (!fast.empty()) {
-                    CHECK(fast[0].a == oracle[0].a);
-                    CHECK(fast[0].b == oracle[0].b);
-                }
+                const auto [oracle, oracle_closes] = check_against_oracle(s, b);
                 if (k % 4 == 0 && oracle.empty() && !oracle_closes) ++dropped_on_line;
                 ++compared;
             }
@@ -293,16 +302,8 @@ TEST_CASE("shaft: add_blocker's inside shortcut gives the exact test's pieces, a
                     const Vec2 near = lerp(p, q, 0.5 + 0.45 * u(rng)) + off * inward;
                     const Vec2 far = lerp(centre, near, 0.3 + 0.3 * std::abs(u(rng)));
                     const Segment b = k % 2 ? Segment{near, far} : Segment{far, near};
-                    std::vector<Segment> fast, oracle;
-                    const bool fast_closes = shaft_detail::add_blocker(s, b, 0, fast);
-                    const bool oracle_closes = add_blocker_oracle(s, b, oracle);
-                    CHECK(fast_closes == oracle_closes);
-                    REQUIRE(fast.size() == oracle.size());
-                    if (!fast.empty()) {
-                        CHECK(fast[0].a == oracle[0].a);
-                        CHECK(fast[0].b == oracle[0].b);
-                        ++(fast[0].a == b.a && fast[0].b == b.b ? whole : cut);
-                    }
+                    const auto [oracle, oracle_closes] = check_against_oracle(s, b);
+                    if (!oracle.empty()) ++(oracle[0].a == b.a && oracle[0].b == b.b ? whole : cut);
                     ++compared;
                 }
             }
