@@ -153,12 +153,16 @@ Hierarchy::Hierarchy(const std::vector<Segment>& segments, int leaf_size, const 
         m_nodes[static_cast<size_t>(k)] = nd;
     }
     for (ClusterNode& nd : m_nodes) nd.blockers = nd.count;
+    m_ordered.resize(m_order.size());
+    for (size_t q = 0; q < m_order.size(); ++q) m_ordered[q] = m_segments[static_cast<size_t>(m_order[q])];
 }
 
 void Hierarchy::set_blockers(const std::vector<char>& can_block) {
     if (can_block.size() != m_segments.size())
         throw std::invalid_argument("Hierarchy::set_blockers: one flag per segment expected");
     m_can_block = can_block;
+    m_can_block_at.resize(m_order.size());
+    for (size_t q = 0; q < m_order.size(); ++q) m_can_block_at[q] = can_block[static_cast<size_t>(m_order[q])];
     // Children come after their parents: count bottom-up.
     for (size_t k = m_nodes.size(); k-- > 0;) {
         ClusterNode& nd = m_nodes[k];

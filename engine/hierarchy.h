@@ -45,6 +45,10 @@ public:
     /// Segment numbers, grouped so that each node's are contiguous.
     const std::vector<int32_t>& order() const { return m_order; }
     const std::vector<Segment>& segments() const { return m_segments; }
+    /// The segment at place q of order(), kept in that order too: a walk
+    /// through neighbouring leaves reads it in sequence (segments() is in
+    /// the caller's order, scattered over the whole scene).
+    const Segment& segment_at(int32_t q) const { return m_ordered[static_cast<size_t>(q)]; }
     int depth() const { return m_depth; }
 
     /// Marks which segments can block light (`can_block[segment number]`,
@@ -54,6 +58,10 @@ public:
     void set_blockers(const std::vector<char>& can_block);
     bool can_block(int segment) const {
         return m_can_block.empty() || m_can_block[static_cast<size_t>(segment)] != 0;
+    }
+    /// can_block of the segment at place q of order().
+    bool can_block_at(int32_t q) const {
+        return m_can_block_at.empty() || m_can_block_at[static_cast<size_t>(q)] != 0;
     }
 
     /// Visits every segment whose node boxes pass `box_test(const Box&)`,
@@ -85,9 +93,8 @@ private:
             if (!box_test(n.box)) continue;
             if (n.leaf()) {
                 for (int32_t k = n.first; k < n.first + n.count; ++k) {
-                    const int32_t s = m_order[static_cast<size_t>(k)];
-                    if (only_blockers && !can_block(s)) continue;
-                    on_segment(s, m_segments[static_cast<size_t>(s)]);
+                    if (only_blockers && !can_block_at(k)) continue;
+                    on_segment(m_order[static_cast<size_t>(k)], m_ordered[static_cast<size_t>(k)]);
                 }
             } else {
                 stack.push_back(n.child[1]);
@@ -101,6 +108,8 @@ private:
     std::vector<int32_t> m_order;
     std::vector<Segment> m_segments;
     std::vector<char> m_can_block;  // per segment number; empty: all
+    std::vector<Segment> m_ordered;    // m_segments[m_order[q]] at q
+    std::vector<char> m_can_block_at;  // m_can_block[m_order[q]] at q; empty: all
     int m_depth = 0;
 };
 

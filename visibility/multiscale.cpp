@@ -813,9 +813,8 @@ MultiscaleResult MultiscaleVisibility::form_factor_skipping(const Segment& i, co
             }
             for (int q = n.first; q < n.first + n.count && !closed; ++q) {
                 if (skipped(q)) continue;
-                const int s = m_hierarchy->order()[static_cast<size_t>(q)];
-                if (!m_hierarchy->can_block(s)) continue;
-                closed = take(q, m_hierarchy->segments()[static_cast<size_t>(s)]);
+                if (!m_hierarchy->can_block_at(q)) continue;
+                closed = take(q, m_hierarchy->segment_at(q));
             }
         }
         return closed;

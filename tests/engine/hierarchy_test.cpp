@@ -133,7 +133,7 @@ TEST_CASE("hierarchy: coincident segments do not split forever") {
     CHECK(h.node(0).count == 100);
 }
 
-TEST_CASE("hierarchy: set_blockers counts per node, and query_blockers walks only them") {
+TEST_CASE("hierarchy: set_blockers counts per node (and per place in order), and query_blockers walks only them") {
     std::mt19937_64 rng(8);
     const auto segs = random_segments(rng, 2000);
     Hierarchy h(segs, 1);
@@ -141,7 +141,19 @@ TEST_CASE("hierarchy: set_blockers counts per node, and query_blockers walks onl
     std::vector<char> can(segs.size(), 0);
     std::uniform_real_distribution<double> U(0, 1);
     for (auto& c : can) c = U(rng) < 0.1 ? 1 : 0;
+    // By place in order(): every segment blocks until set_blockers says
+    // otherwise, and each place holds its segment.
+    long mismatched = 0;
+    for (size_t q = 0; q < segs.size(); ++q) {
+        const Segment& g = segs[static_cast<size_t>(h.order()[q])];
+        mismatched += !(h.segment_at(static_cast<int32_t>(q)).a == g.a && h.segment_at(static_cast<int32_t>(q)).b == g.b);
+        mismatched += !h.can_block_at(static_cast<int32_t>(q));
+    }
+    CHECK(mismatched == 0);
     h.set_blockers(can);
+    for (size_t q = 0; q < segs.size(); ++q)
+        mismatched += h.can_block_at(static_cast<int32_t>(q)) != (can[static_cast<size_t>(h.order()[q])] != 0);
+    CHECK(mismatched == 0);
     for (const ClusterNode& nd : h.nodes()) {
         int expected = 0;
         for (int k = nd.first; k < nd.first + nd.count; ++k) expected += can[static_cast<size_t>(h.order()[static_cast<size_t>(k)])];
