@@ -175,6 +175,7 @@ inline bool add_blocker(const Shaft& shaft, const Segment& s, [[maybe_unused]] d
     // whether either end touches a patch's line. The distance of x to the
     // line is measured from the patch's nearer end (orient(p, q, x) is
     // |q - p| times that distance; from q it is -orient(q, p, x)).
+    // (p, q: patch edge e's ends, shaft.v[e] and shaft.v[e + 1].)
     const auto on_line = [&](size_t e, Vec2 p, Vec2 q, Vec2 x) {
         // Clearly off the line first, in plain arithmetic: the test below
         // is o <= tol local |pq| with local <= 4 max(|x|, |p|, |q|) (max
@@ -182,12 +183,7 @@ inline bool add_blocker(const Shaft& shaft, const Segment& s, [[maybe_unused]] d
         // that) and |pq| <= |n|_1; o is dot(n, x - p) within culling_slack
         // of |n|_1 (|x| + |p| + |q|), whether taken from p or from q. Above
         // that bound the answer is false for sure.
-        {
-            const Vec2 n = shaft.normal[e];
-            const double fast = n.x * (x.x - p.x) + n.y * (x.y - p.y);
-            const double mx = magnitude(x);
-            if (fast > bar(e, mx)) return false;
-        }
+        if (clearly_inside(e, x, bar(e, magnitude(x)))) return false;
         const bool from_p = distance(x, p) <= distance(x, q);
         const Vec2 near = from_p ? p : q;
         const double o = from_p ? orient(p, q, x) : -orient(q, p, x);
