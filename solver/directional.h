@@ -27,6 +27,7 @@
 /// 4x margin over h^2 f''/8. It is an estimate, not a bound: a convex kink
 /// and a concave peak of two elements' lobes can cancel in one second
 /// difference (tests/solver/cluster_model_test.cpp measures how often).
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <numbers>
@@ -97,12 +98,18 @@ inline const std::array<Vec2, directional_bins>& bin_directions() {
 /// Adds the lobe w cos+(n . u) to a table held as two arrays: to its
 /// samples (w cos+(n . u(phi_k))), unless `samples` is null (a table kept
 /// without samples, solver/table_array.h), and to its linear part (w n).
+/// (This and read_cosine_lobe add w max(c, 0) at every bin, not only where
+/// c > 0: a lobe's bins are one run of about half the table, which a branch
+/// mispredicts at both ends, once per side and operator application; w * 0
+/// added to a finite sum leaves it as it was. The same sums bit for bit,
+/// tests/solver/cluster_model_test.cpp; on the 1000-segment forest at eps
+/// 50, 5% fewer instructions in all, callgrind, one thread.)
 inline void add_cosine_lobe(double* samples, double* linear, Vec2 n, double w) {
     if (samples) {
         const auto& d = bin_directions();
         for (int k = 0; k < directional_bins; ++k) {
             const double c = n.x * d[static_cast<size_t>(k)].x + n.y * d[static_cast<size_t>(k)].y;
-            if (c > 0) samples[k] += w * c;
+            samples[k] += w * std::max(c, 0.0);
         }
     }
     linear[0] += w * n.x;
@@ -123,7 +130,7 @@ inline double read_cosine_lobe(const double* samples, const double* linear, Vec2
         const auto& d = bin_directions();
         for (int k = 0; k < directional_bins; ++k) {
             const double c = n.x * d[static_cast<size_t>(k)].x + n.y * d[static_cast<size_t>(k)].y;
-            if (c > 0) s += samples[k] * c;
+            s += samples[k] * std::max(c, 0.0);
         }
     }
     return s + n.x * linear[0] + n.y * linear[1];

@@ -16,6 +16,7 @@
 #include "engine/scene.h"
 #include "solver/hierarchical_solver.h"
 #include "support/forest_scene.h"
+#include "support/ring_scene.h"
 
 using namespace flatrad;
 using flatrad::test::forest_json;
@@ -103,4 +104,22 @@ TEST_CASE("hierarchical threads: closure screens give the same solution with one
     const Solution one = check_thread_independent(scene, o, 2);
     CHECK(one.stats.visibility.screens > 0);  // (what this case is for)
     CHECK(one.stats.visibility.screened > 0);
+}
+
+TEST_CASE("hierarchical threads: the operator's passes split over subtrees give one thread's sums") {
+    // From 2048 nodes on, with two threads, pull_tables and push_down run
+    // disjoint subtrees side by side and the nodes above them on one
+    // thread (hierarchical_solver.cpp, OpSchedule). Every table must get
+    // its children's shares in one thread's order: a share added out of
+    // order changes the last bits, and the links and radiosity follow.
+    // A round room with a lamp inside, at a tight eps: walls cut into
+    // elements several levels deep (subtrees of elements under a leaf),
+    // chains, tables both ways.
+    const Scene ring = flatrad::test::ring_scene(3000, 0.7, 0.0, true);
+    HierarchicalOptions o;
+    o.eps = 1e-3;
+    const Solution one = check_thread_independent(ring, o, 3);
+    // (What this case is for: elements are nodes, so the operator has more
+    // than the 2048 nodes from which it is split.)
+    CHECK(one.stats.elements > 2048);
 }
