@@ -31,9 +31,30 @@ double max_of(const std::vector<double>& v) {
 // A JSON number, or null when not finite (JSON has no inf or NaN).
 nlohmann::ordered_json number(double v) { return std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json(); }
 
-nlohmann::ordered_json error_json(const CompareError& e) {
-    return {{"relative_l2", number(e.relative_l2)}, {"max_relative", number(e.max_relative)},
-            {"worst_patch", e.worst_patch}};
+// The error's figures; with the reference given, also where it lies: the
+// patches with the largest shares of the squared error, each with both
+// radiosities.
+nlohmann::ordered_json error_json(const CompareError& e, const Scene* scene = nullptr, const Solution* solution = nullptr,
+                                  const Solution* reference = nullptr) {
+    nlohmann::ordered_json j = {{"relative_l2", number(e.relative_l2)}, {"max_relative", number(e.max_relative)},
+                                {"worst_patch", e.worst_patch}};
+    if (!scene) return j;
+    nlohmann::ordered_json largest = nlohmann::ordered_json::array();
+    for (const PatchErrorShare& s : e.largest) {
+        const Patch& patch = scene->patches[static_cast<size_t>(s.patch)];
+        nlohmann::ordered_json b = nlohmann::ordered_json::array(), r = nlohmann::ordered_json::array();
+        for (double v : solution->patches[static_cast<size_t>(s.patch)].radiosity) b.push_back(number(v));
+        for (double v : reference->patches[static_cast<size_t>(s.patch)].radiosity) r.push_back(number(v));
+        largest.push_back({{"patch", s.patch},
+                           {"surface", scene->surfaces[static_cast<size_t>(patch.surface)].name},
+                           {"segment", patch.segment - scene->surfaces[static_cast<size_t>(patch.surface)].first_segment},
+                           {"side", side_name(patch.side)},
+                           {"share", number(s.share)},
+                           {"radiosity", b},
+                           {"reference", r}});
+    }
+    j["largest"] = largest;
+    return j;
 }
 
 nlohmann::ordered_json run_json(const Solution& s) {
@@ -143,7 +164,7 @@ int run_compare(const CompareArgs& args, std::ostream& out, std::ostream& err) {
     j["scene"] = scene.name;
     j["command"] = "compare";
     nlohmann::ordered_json h = {{"eps", hier.eps}, {"vis_eps", hier.vis_eps}};
-    h["error"] = error_json(h_err);
+    h["error"] = error_json(h_err, &scene, &hier, &reference);
     h.update(run_json(hier));
     j["hierarchical"] = h;
     nlohmann::ordered_json x = {{"subdivide", reference_K}};
@@ -176,6 +197,25 @@ int run_compare(const CompareArgs& args, std::ostream& out, std::ostream& err) {
                            std::isfinite(estimate) ? "<= " + sci(estimate) + " (est.)" : "unknown");
         err << fmt::format("  {:<22}{:>18}{:>22}\n", "max relative error", sci(h_err.max_relative),
                            std::isnan(ref.estimate_max_relative) ? "?" : "<= " + sci(ref.estimate_max_relative) + " (est.)");
+        // Where the error lies: the patches with the largest shares of it.
+        for (size_t q = 0; q < h_err.largest.size() && q < 3; ++q) {
+            const PatchErrorShare& s = h_err.largest[q];
+            const Patch& patch = scene.patches[static_cast<size_t>(s.patch)];
+            const Surface& surface = scene.surfaces[static_cast<size_t>(patch.surface)];
+            const std::string where =
+                surface.segment_count > 1
+                    ? fmt::format("{} segment {} {}", surface.name, patch.segment - surface.first_segment, side_name(patch.side))
+                    : fmt::format("{} {}", surface.name, side_name(patch.side));
+            // Its radiosity in the channel where it errs most.
+            const auto& b = hier.patches[static_cast<size_t>(s.patch)].radiosity;
+            const auto& r = reference.patches[static_cast<size_t>(s.patch)].radiosity;
+            size_t c = 0;
+            for (size_t k = 1; k < b.size(); ++k)
+                if (std::abs(b[k] - r[k]) > std::abs(b[c] - r[c])) c = k;
+            err << fmt::format("  {:<22}{:>18}   {}: {:.4g} against {:.4g}{}\n", q == 0 ? "largest errors" : "",
+                               fmt::format("{:.1f}% of L2^2", 100 * s.share), where, b[c], r[c],
+                               b.size() > 1 ? fmt::format(" (channel {})", c) : "");
+        }
         err << fmt::format("  {:<22}{:>18}{:>22}\n", "energy balance", sci(max_of(hier.totals.balance)),
                            sci(max_of(reference.totals.balance)));
         err << fmt::format("  {:<22}{:>18}{:>22}\n", "time", fmt::format("{:.3g} s", hier.stats.time_s),

@@ -1,5 +1,6 @@
 #include "cli/solution_error.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -17,18 +18,34 @@ CompareError compare_solutions(const Scene& scene, const Solution& solution, con
     // very different brightness (a lamp beside shadows).
     long double diff2 = 0, ref2 = 0, length = 0;
     std::vector<long double> ref2_c(static_cast<size_t>(C), 0);
+    std::vector<long double> diff2_p(scene.patches.size(), 0);  // per patch, all channels
     for (size_t p = 0; p < scene.patches.size(); ++p) {
         const long double L = scene.patches[p].length;
         length += L;
         for (int c = 0; c < C; ++c) {
             const long double r = reference.patches[p].radiosity[static_cast<size_t>(c)];
             const long double d = solution.patches[p].radiosity[static_cast<size_t>(c)] - r;
-            diff2 += L * d * d;
+            diff2_p[p] += L * d * d;
             ref2 += L * r * r;
             ref2_c[static_cast<size_t>(c)] += L * r * r;
         }
+        diff2 += diff2_p[p];
     }
     CompareError e;
+    // The largest shares: a partial sort of the patch numbers (a share of
+    // a sum that is not finite is left out: no share says anything then).
+    if (diff2 > 0 && std::isfinite(static_cast<double>(diff2))) {
+        std::vector<int> order;
+        for (size_t p = 0; p < diff2_p.size(); ++p)
+            if (diff2_p[p] > 0) order.push_back(static_cast<int>(p));
+        const size_t k = std::min<size_t>(largest_error_patches, order.size());
+        std::partial_sort(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(k), order.end(), [&](int a, int b) {
+            const long double x = diff2_p[static_cast<size_t>(a)], y = diff2_p[static_cast<size_t>(b)];
+            return x > y || (x == y && a < b);
+        });
+        for (size_t q = 0; q < k; ++q)
+            e.largest.push_back({order[q], static_cast<double>(diff2_p[static_cast<size_t>(order[q])] / diff2)});
+    }
     const double inf = std::numeric_limits<double>::infinity();
     e.relative_l2 = diff2 == 0 ? 0 : (ref2 > 0 ? static_cast<double>(std::sqrt(diff2 / ref2)) : inf);
     for (size_t p = 0; p < scene.patches.size(); ++p)

@@ -11,15 +11,33 @@
 ///                  error counts at the scale of the scene, not of itself).
 /// Both are 0 when the solutions agree, and 0 (not NaN) for an all-dark
 /// reference that is matched exactly; +inf for a mismatch against it.
+#include <vector>
+
 #include "engine/scene.h"
 #include "solver/solution.h"
 
 namespace flatrad {
 
+/// A patch's share of the squared L2 error: sum_c L_p (B_pc - R_pc)^2 over
+/// the sum of that over all patches.
+struct PatchErrorShare {
+    int patch = -1;
+    double share = 0;
+};
+
+/// Where the error lies: how many patches `largest` lists at most.
+inline constexpr int largest_error_patches = 5;
+
 struct CompareError {
     double relative_l2 = 0;
     double max_relative = 0;
     int worst_patch = -1;  ///< where max_relative is reached; -1 when none
+    /// The patches with the largest shares of the squared L2 error, largest
+    /// first (ties by patch number), at most largest_error_patches of them,
+    /// none with a share of 0: empty when the solutions agree. A relative
+    /// L2 error dominated by a few patches is told apart from one spread
+    /// over the scene (a forest's lit trees next to its lamp, say).
+    std::vector<PatchErrorShare> largest;
 };
 
 /// Errors of `solution` against `reference`, two solves of `scene` (same

@@ -3,6 +3,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -145,4 +146,65 @@ TEST_CASE("compare_solutions: zero for equal solutions, scale-free") {
     for (auto& p : b.patches) p.radiosity[0] *= 1.01;
     CHECK(flatrad::compare_solutions(scene, b, a).relative_l2 == doctest::Approx(0.01).epsilon(1e-9));
     fs::remove(path);
+}
+
+TEST_CASE("compare_solutions: where the error lies, largest shares first") {
+    const std::string path = write_scene(pillar_box);
+    const flatrad::Scene scene = flatrad::load_scene(path);
+    const flatrad::Solution a = flatrad::solve_exact(scene, {2, 0});
+    CHECK(flatrad::compare_solutions(scene, a, a).largest.empty());  // nothing to place
+    // Two patches off by known amounts: shares L_p d_p^2 / sum.
+    flatrad::Solution b = a;
+    b.patches[2].radiosity[0] += 0.1;
+    b.patches[5].radiosity[0] -= 0.3;
+    const double w2 = scene.patches[2].length * 0.1 * 0.1, w5 = scene.patches[5].length * 0.3 * 0.3;
+    const flatrad::CompareError e = flatrad::compare_solutions(scene, b, a);
+    REQUIRE(e.largest.size() == 2);
+    const bool five_first = w5 > w2;
+    CHECK(e.largest[0].patch == (five_first ? 5 : 2));
+    CHECK(e.largest[1].patch == (five_first ? 2 : 5));
+    // (Rounding: the sums are taken in long double, the differences in
+    // double, so a share is exact to ~1e-15 relative; 1e-12 is room.)
+    constexpr double share_rounding = 1e-12;
+    CHECK(e.largest[0].share == doctest::Approx(std::max(w2, w5) / (w2 + w5)).epsilon(share_rounding));
+    CHECK(e.largest[1].share == doctest::Approx(std::min(w2, w5) / (w2 + w5)).epsilon(share_rounding));
+    // Every patch off: at most largest_error_patches listed, in order.
+    flatrad::Solution c = a;
+    for (size_t p = 0; p < c.patches.size(); ++p) c.patches[p].radiosity[0] += 0.01 * static_cast<double>(p + 1);
+    const flatrad::CompareError all = flatrad::compare_solutions(scene, c, a);
+    REQUIRE(static_cast<int>(all.largest.size()) == std::min<int>(flatrad::largest_error_patches, static_cast<int>(scene.patches.size())));
+    double sum = 0;
+    for (size_t q = 0; q < all.largest.size(); ++q) {
+        CAPTURE(q);
+        CHECK(all.largest[q].share > 0);
+        if (q > 0) CHECK(all.largest[q].share <= all.largest[q - 1].share);
+        sum += all.largest[q].share;
+    }
+    CHECK(sum <= 1 + share_rounding);
+    fs::remove(path);
+}
+
+TEST_CASE("compare: the JSON and the table say where the error lies") {
+    const std::string scene = write_scene(pillar_box);
+    const Run r = run({"compare", scene, "--eps", "1e-1", "--max-elements", "2100"});
+    REQUIRE(r.status == 0);
+    const json j = json::parse(r.out);
+    const json& largest = j["hierarchical"]["error"]["largest"];
+    REQUIRE(largest.is_array());
+    REQUIRE(!largest.empty());  // eps 0.1 leaves an error somewhere
+    CHECK(largest.size() <= static_cast<size_t>(flatrad::largest_error_patches));
+    const std::vector<std::string> surfaces{"floor", "walls", "pillar"};
+    double previous = 2;
+    for (const json& p : largest) {
+        CHECK(std::find(surfaces.begin(), surfaces.end(), p["surface"].get<std::string>()) != surfaces.end());
+        const double share = p["share"].get<double>();
+        CHECK(share > 0);
+        CHECK(share <= previous);
+        previous = share;
+        REQUIRE(p["radiosity"].size() == 1);
+        REQUIRE(p["reference"].size() == 1);
+        CHECK(p["radiosity"][0].get<double>() != p["reference"][0].get<double>());
+    }
+    CHECK(r.err.find("largest errors") != std::string::npos);
+    fs::remove(scene);
 }
