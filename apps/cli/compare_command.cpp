@@ -31,23 +31,21 @@ double max_of(const std::vector<double>& v) {
 // A JSON number, or null when not finite (JSON has no inf or NaN).
 nlohmann::ordered_json number(double v) { return std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json(); }
 
-// The error's figures; with the reference given, also where it lies: the
-// patches with the largest shares of the squared error, each with both
-// radiosities.
-nlohmann::ordered_json error_json(const CompareError& e, const Scene* scene = nullptr, const Solution* solution = nullptr,
-                                  const Solution* reference = nullptr) {
+// The error's figures, and where it lies: the patches with the largest
+// shares of the squared error, each with both radiosities.
+nlohmann::ordered_json error_json(const CompareError& e, const Scene& scene, const Solution& solution,
+                                  const Solution& reference) {
     nlohmann::ordered_json j = {{"relative_l2", number(e.relative_l2)}, {"max_relative", number(e.max_relative)},
                                 {"worst_patch", e.worst_patch}};
-    if (!scene) return j;
     nlohmann::ordered_json largest = nlohmann::ordered_json::array();
     for (const PatchErrorShare& s : e.largest) {
-        const Patch& patch = scene->patches[static_cast<size_t>(s.patch)];
+        const Patch& patch = scene.patches[static_cast<size_t>(s.patch)];
         nlohmann::ordered_json b = nlohmann::ordered_json::array(), r = nlohmann::ordered_json::array();
-        for (double v : solution->patches[static_cast<size_t>(s.patch)].radiosity) b.push_back(number(v));
-        for (double v : reference->patches[static_cast<size_t>(s.patch)].radiosity) r.push_back(number(v));
+        for (double v : solution.patches[static_cast<size_t>(s.patch)].radiosity) b.push_back(number(v));
+        for (double v : reference.patches[static_cast<size_t>(s.patch)].radiosity) r.push_back(number(v));
         largest.push_back({{"patch", s.patch},
-                           {"surface", scene->surfaces[static_cast<size_t>(patch.surface)].name},
-                           {"segment", patch.segment - scene->surfaces[static_cast<size_t>(patch.surface)].first_segment},
+                           {"surface", scene.surfaces[static_cast<size_t>(patch.surface)].name},
+                           {"segment", patch.segment - scene.surfaces[static_cast<size_t>(patch.surface)].first_segment},
                            {"side", side_name(patch.side)},
                            {"share", number(s.share)},
                            {"radiosity", b},
@@ -164,7 +162,7 @@ int run_compare(const CompareArgs& args, std::ostream& out, std::ostream& err) {
     j["scene"] = scene.name;
     j["command"] = "compare";
     nlohmann::ordered_json h = {{"eps", hier.eps}, {"vis_eps", hier.vis_eps}};
-    h["error"] = error_json(h_err, &scene, &hier, &reference);
+    h["error"] = error_json(h_err, scene, hier, reference);
     h.update(run_json(hier));
     j["hierarchical"] = h;
     nlohmann::ordered_json x = {{"subdivide", reference_K}};
