@@ -1166,6 +1166,8 @@ void run_versus(VersusOptions o, const std::string& cmd) {
                "       discretisation: this measures agreement with it, not with the true solution\n"
                "       {}.\n"
                "       top5: the share of the squared error in the 5 patches that hold most of it (cli/solution_error.h).\n"
+               "       patch_med: each patch's error over its own reference value, the length-weighted median\n"
+               "       (cli/solution_error.h): the dim patches' error, which rel_l2 does not show.\n"
                "       The lamp's own emission dominates that norm; balance (|emitted - absorbed| / emitted, the\n"
                "       hierarchical solution's) shows what the norm hides: transport the links over- or\n"
                "       under-estimate.\n"
@@ -1245,8 +1247,8 @@ void run_versus(VersusOptions o, const std::string& cmd) {
         rows.push_back(row);
     }
 
-    fmt::print("\n{:>8} {:>9} {:>10} {:>10} {:>6} {:>11} {:>11} {:>6} {:>9} {:>9} {:>6}{}\n", "eps", "time_s", "elements",
-               "links", "iters", "rel_l2", "max_rel", "top5", "balance", "speedup", "<=1%",
+    fmt::print("\n{:>8} {:>9} {:>10} {:>10} {:>6} {:>11} {:>11} {:>6} {:>9} {:>9} {:>9} {:>6}{}\n", "eps", "time_s",
+               "elements", "links", "iters", "rel_l2", "max_rel", "top5", "patch_med", "balance", "speedup", "<=1%",
                fine ? fmt::format(" {:>11}", "rel_l2_2K") : "");
     const Row* best = nullptr;
     for (const Row& r : rows) {
@@ -1258,9 +1260,9 @@ void run_versus(VersusOptions o, const std::string& cmd) {
         if (ok && !best) best = &r;
         double top = 0;  // the share of the squared error in the patches holding most of it
         for (const flatrad::PatchErrorShare& q : r.error.largest) top += q.share;
-        fmt::print("{:>8g} {:>9.3f} {:>10} {:>10} {:>6} {:>11.3e} {:>11.3e} {:>5.0f}% {:>9.2e} {:>9.1f} {:>6}{}\n", r.eps,
-                   r.time_s, r.elements, r.links, r.iterations, r.error.relative_l2, r.error.max_relative, 100 * top,
-                   r.balance,
+        fmt::print("{:>8g} {:>9.3f} {:>10} {:>10} {:>6} {:>11.3e} {:>11.3e} {:>5.0f}% {:>9.2e} {:>9.2e} {:>9.1f} {:>6}{}\n",
+                   r.eps, r.time_s, r.elements, r.links, r.iterations, r.error.relative_l2, r.error.max_relative,
+                   100 * top, r.error.patch_relative_median, r.balance,
                    exact_s / r.time_s, ok ? "yes" : "no",
                    fine ? fmt::format(" {:>11.3e}", r.error_2K.relative_l2) : "");
     }

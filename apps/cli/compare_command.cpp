@@ -52,6 +52,9 @@ nlohmann::ordered_json error_json(const CompareError& e, const Scene& scene, con
                            {"reference", r}});
     }
     j["largest"] = largest;
+    j["patch_relative"] = {{"median", number(e.patch_relative_median)},
+                           {"p90", number(e.patch_relative_p90)},
+                           {"max", number(e.patch_relative_max)}};
     return j;
 }
 
@@ -79,7 +82,9 @@ CLI::App* add_compare_command(CLI::App& app, CompareArgs& a) {
         "and 2K) is at most 1/10 of the hierarchical error against the 2K solution, or until the next mesh "
         "would pass --max-elements or the exact solver's memory limit (then \"reached\": false). Errors are "
         "over patch radiosities, length-weighted, all channels: relative_l2, and max_relative (largest "
-        "|difference| over the reference's length-weighted RMS). Prints a table on stderr and JSON "
+        "|difference| over the reference's length-weighted RMS), both at the scale of the scene's light; "
+        "and patch_relative: each patch's |difference| over its own reference value, its length-weighted "
+        "median, 90th percentile and max (how well dim surfaces are known). Prints a table on stderr and JSON "
         "{scene, hierarchical, exact, reference} on stdout (or -o).\n"
         "Exit status: 0 done; 2 bad input or bad arguments (one line on stderr); 1 anything else.");
     cmd->add_option("SCENE", a.scene, "Scene file (JSON).")->required()->type_name("FILE");
@@ -166,7 +171,12 @@ int run_compare(const CompareArgs& args, std::ostream& out, std::ostream& err) {
     h.update(run_json(hier));
     j["hierarchical"] = h;
     nlohmann::ordered_json x = {{"subdivide", reference_K}};
-    x["error"] = {{"relative_l2", number(estimate)}, {"max_relative", number(ref.estimate_max_relative)},
+    x["error"] = {{"relative_l2", number(estimate)},
+                  {"max_relative", number(ref.estimate_max_relative)},
+                  {"patch_relative",
+                   {{"median", number(ref.estimate_patch_relative_median)},
+                    {"p90", number(ref.estimate_patch_relative_p90)},
+                    {"max", number(ref.estimate_patch_relative_max)}}},
                   {"estimated", true}};
     x.update(run_json(reference));
     x["time_total_s"] = ref.time_total_s;
@@ -195,6 +205,14 @@ int run_compare(const CompareArgs& args, std::ostream& out, std::ostream& err) {
                            std::isfinite(estimate) ? "<= " + sci(estimate) + " (est.)" : "unknown");
         err << fmt::format("  {:<22}{:>18}{:>22}\n", "max relative error", sci(h_err.max_relative),
                            std::isnan(ref.estimate_max_relative) ? "?" : "<= " + sci(ref.estimate_max_relative) + " (est.)");
+        // Each patch at its own scale (the dim ones too).
+        auto estimated = [](double v) { return std::isnan(v) ? std::string("?") : "<= " + sci(v) + " (est.)"; };
+        err << fmt::format("  {:<22}{:>18}{:>22}\n", "per patch: median", sci(h_err.patch_relative_median),
+                           estimated(ref.estimate_patch_relative_median));
+        err << fmt::format("  {:<22}{:>18}{:>22}\n", "           90%", sci(h_err.patch_relative_p90),
+                           estimated(ref.estimate_patch_relative_p90));
+        err << fmt::format("  {:<22}{:>18}{:>22}\n", "           max", sci(h_err.patch_relative_max),
+                           estimated(ref.estimate_patch_relative_max));
         // Where the error lies: the patches with the largest shares of it.
         for (size_t q = 0; q < h_err.largest.size() && q < 3; ++q) {
             const PatchErrorShare& s = h_err.largest[q];

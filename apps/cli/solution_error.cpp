@@ -60,6 +60,35 @@ CompareError compare_solutions(const Scene& scene, const Solution& solution, con
             }
         }
     if (e.max_relative == 0) e.worst_patch = -1;
+    // Each patch at its own scale: length-weighted quantiles of q_pc.
+    struct Weighted {
+        double q, length;
+    };
+    std::vector<Weighted> q;
+    q.reserve(scene.patches.size() * static_cast<size_t>(C));
+    long double total = 0;
+    for (size_t p = 0; p < scene.patches.size(); ++p)
+        for (int c = 0; c < C; ++c) {
+            const double r = reference.patches[p].radiosity[static_cast<size_t>(c)];
+            const double d = std::abs(solution.patches[p].radiosity[static_cast<size_t>(c)] - r);
+            const double rel = d == 0 ? 0 : (r != 0 ? d / std::abs(r) : inf);
+            q.push_back({std::isnan(rel) ? inf : rel, scene.patches[p].length});
+            total += scene.patches[p].length;
+        }
+    if (!q.empty()) {
+        std::sort(q.begin(), q.end(), [](const Weighted& a, const Weighted& b) { return a.q < b.q; });
+        auto quantile = [&](double share) {
+            long double below = 0;
+            for (const Weighted& w : q) {
+                below += w.length;
+                if (below >= share * total) return w.q;
+            }
+            return q.back().q;  // (rounding of the running sum)
+        };
+        e.patch_relative_median = quantile(0.5);
+        e.patch_relative_p90 = quantile(0.9);
+        e.patch_relative_max = q.back().q;
+    }
     return e;
 }
 

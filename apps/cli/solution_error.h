@@ -11,6 +11,15 @@
 ///                  error counts at the scale of the scene, not of itself).
 /// Both are 0 when the solutions agree, and 0 (not NaN) for an all-dark
 /// reference that is matched exactly; +inf for a mismatch against it.
+///
+/// Both measure errors at the scale of the scene's light, which its
+/// brightest patches set. Each patch's error at its own scale,
+///   q_pc = |B_pc - R_pc| / R_pc   (0 where both are 0, +inf where only
+///                                  R_pc is),
+/// is summarised by its length-weighted quantiles over patches and
+/// channels (patch_relative_*): how well each surface is known, the dim
+/// ones included (a forest's shade, whose errors of 10x and more the
+/// relative L2 of 1% at its lamp does not show).
 #include <vector>
 
 #include "engine/scene.h"
@@ -38,6 +47,10 @@ struct CompareError {
     /// L2 error dominated by a few patches is told apart from one spread
     /// over the scene (a forest's lit trees next to its lamp, say).
     std::vector<PatchErrorShare> largest;
+    /// q_pc above: the length-weighted median, the 90th percentile (the
+    /// least q with at least that share of the length at or below it) and
+    /// the largest; 0 with no patch.
+    double patch_relative_median = 0, patch_relative_p90 = 0, patch_relative_max = 0;
 };
 
 /// Errors of `solution` against `reference`, two solves of `scene` (same

@@ -184,6 +184,50 @@ TEST_CASE("compare_solutions: where the error lies, largest shares first") {
     fs::remove(path);
 }
 
+TEST_CASE("compare_solutions: each patch at its own scale, by length-weighted quantiles") {
+    const std::string path = write_scene(pillar_box);
+    const flatrad::Scene scene = flatrad::load_scene(path);
+    const flatrad::Solution a = flatrad::solve_exact(scene, {2, 0});
+    for (const auto& p : a.patches) REQUIRE(p.radiosity[0] > 0);  // (every patch lit: q is finite)
+    const flatrad::CompareError same = flatrad::compare_solutions(scene, a, a);
+    CHECK(same.patch_relative_median == 0);
+    CHECK(same.patch_relative_p90 == 0);
+    CHECK(same.patch_relative_max == 0);
+    // Every patch 10% high but one, k, 3x high: the median is 0.1 whatever
+    // the brightness (the relative L2 is not), the max 2; the 90th
+    // percentile is 2 exactly when k holds more than a tenth of the length.
+    // (Rounding: B (1 + f) - B over B is f to a few ulps; 1e-12 is room.)
+    constexpr double rounding = 1e-12;
+    double total = 0;
+    for (const auto& p : scene.patches) total += p.length;
+    for (size_t k : {size_t{0}, scene.patches.size() - 1}) {
+        CAPTURE(k);
+        flatrad::Solution b = a;
+        for (size_t p = 0; p < b.patches.size(); ++p) b.patches[p].radiosity[0] *= p == k ? 3.0 : 1.1;
+        const flatrad::CompareError e = flatrad::compare_solutions(scene, b, a);
+        REQUIRE(scene.patches[k].length < 0.5 * total);
+        CHECK(e.patch_relative_median == doctest::Approx(0.1).epsilon(rounding));
+        CHECK(e.patch_relative_max == doctest::Approx(2.0).epsilon(rounding));
+        CHECK(e.patch_relative_p90 == doctest::Approx(scene.patches[k].length > 0.1 * total ? 2.0 : 0.1).epsilon(rounding));
+        // Scale-free: both solutions times 1000, the same quantiles.
+        flatrad::Solution a2 = a, b2 = b;
+        for (auto& p : a2.patches) p.radiosity[0] *= 1000;
+        for (auto& p : b2.patches) p.radiosity[0] *= 1000;
+        const flatrad::CompareError e2 = flatrad::compare_solutions(scene, b2, a2);
+        CHECK(e2.patch_relative_median == doctest::Approx(e.patch_relative_median).epsilon(rounding));
+        CHECK(e2.patch_relative_p90 == doctest::Approx(e.patch_relative_p90).epsilon(rounding));
+    }
+    // A patch dark in the reference: 0 where the solution is dark too, +inf
+    // (the max) where it is not.
+    flatrad::Solution dark = a;
+    dark.patches[3].radiosity[0] = 0;
+    CHECK(flatrad::compare_solutions(scene, dark, dark).patch_relative_max == 0);
+    flatrad::Solution lit = dark;
+    lit.patches[3].radiosity[0] = 0.5;
+    CHECK(std::isinf(flatrad::compare_solutions(scene, lit, dark).patch_relative_max));
+    fs::remove(path);
+}
+
 TEST_CASE("compare: the JSON and the table say where the error lies") {
     const std::string scene = write_scene(pillar_box);
     const Run r = run({"compare", scene, "--eps", "1e-1", "--max-elements", "2100"});
@@ -206,5 +250,16 @@ TEST_CASE("compare: the JSON and the table say where the error lies") {
         CHECK(p["radiosity"][0].get<double>() != p["reference"][0].get<double>());
     }
     CHECK(r.err.find("largest errors") != std::string::npos);
+    // Each patch at its own scale, for the hierarchical solution and as the
+    // reference's own estimate.
+    const json& q = j["hierarchical"]["error"]["patch_relative"];
+    REQUIRE(finite_number(q["median"]));
+    REQUIRE(finite_number(q["p90"]));
+    REQUIRE(finite_number(q["max"]));
+    CHECK(q["median"].get<double>() > 0);  // eps 0.1 leaves every patch a little off
+    CHECK(q["median"].get<double>() <= q["p90"].get<double>());
+    CHECK(q["p90"].get<double>() <= q["max"].get<double>());
+    CHECK(finite_number(j["exact"]["error"]["patch_relative"]["p90"]));
+    CHECK(r.err.find("per patch: median") != std::string::npos);
     fs::remove(scene);
 }
