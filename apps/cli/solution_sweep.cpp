@@ -206,11 +206,12 @@ std::string solution_sweep_csv(const SolutionSweep& s, const Scene& scene) {
                            last ? " (the reference itself)" : "");
     }
     csv += "eps,vis_eps,time_s,relative_l2,max_relative,balance,elements,links,iterations,reference_subdivide,"
-           "reference_time_s\n";
+           "reference_time_s,patch_relative_median,patch_relative_p90\n";
     for (const SolutionSweepRow& row : s.rows)
-        csv += fmt::format("{},{},{},{},{},{},{},{},{},{},{}\n", row.eps, row.vis_eps, row.time_s,
+        csv += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{}\n", row.eps, row.vis_eps, row.time_s,
                            row.error.relative_l2, row.error.max_relative, row.balance, row.elements, row.links,
-                           row.iterations, r.subdivide(), ref.stats.time_s);
+                           row.iterations, r.subdivide(), ref.stats.time_s, row.error.patch_relative_median,
+                           row.error.patch_relative_p90);
     return csv;
 }
 

@@ -255,7 +255,8 @@ const std::string closed_box = std::string(FLATRAD_DATA_DIR) + "/closed_box.json
 
 const std::vector<std::string> solution_header = {
     "eps",   "vis_eps", "time_s",     "relative_l2", "max_relative",        "balance",
-    "elements", "links", "iterations", "reference_subdivide", "reference_time_s"};
+    "elements", "links", "iterations", "reference_subdivide", "reference_time_s", "patch_relative_median",
+    "patch_relative_p90"};
 
 // Refinement is greedy, so a smaller eps is not always better on every
 // patch: a finer row may be up to this factor worse than the coarser row
