@@ -200,8 +200,10 @@ TEST_CASE("compare_solutions: each patch at its own scale, by length-weighted qu
     constexpr double rounding = 1e-12;
     double total = 0;
     for (const auto& p : scene.patches) total += p.length;
+    int over_tenth = 0, under_tenth = 0;  // both cases of the 90th percentile are checked
     for (size_t k : {size_t{0}, scene.patches.size() - 1}) {
         CAPTURE(k);
+        ++(scene.patches[k].length > 0.1 * total ? over_tenth : under_tenth);
         flatrad::Solution b = a;
         for (size_t p = 0; p < b.patches.size(); ++p) b.patches[p].radiosity[0] *= p == k ? 3.0 : 1.1;
         const flatrad::CompareError e = flatrad::compare_solutions(scene, b, a);
@@ -217,6 +219,8 @@ TEST_CASE("compare_solutions: each patch at its own scale, by length-weighted qu
         CHECK(e2.patch_relative_median == doctest::Approx(e.patch_relative_median).epsilon(rounding));
         CHECK(e2.patch_relative_p90 == doctest::Approx(e.patch_relative_p90).epsilon(rounding));
     }
+    CHECK(over_tenth == 1);   // the floor, 1 of 4.8
+    CHECK(under_tenth == 1);  // a pillar side, 0.2 of 4.8
     // A patch dark in the reference: 0 where the solution is dark too, +inf
     // (the max) where it is not.
     flatrad::Solution dark = a;
