@@ -276,13 +276,18 @@ SvgPlot solution_error_eps_plot(const SolutionSweep& s, const Scene& scene) {
     PlotSeries max{"max relative", {}, {}, PlotMark::LineAndPoints, orange};
     max.dashed = true;
     PlotSeries balance{"energy balance", {}, {}, PlotMark::LineAndPoints, green};
+    // Each patch at its own scale (cli/solution_error.h): where the scene
+    // has dim surfaces, far above the relative L2.
+    PlotSeries per_patch{"per patch |B - R| / R, median", {}, {}, PlotMark::LineAndPoints, red};
+    per_patch.dashed = true;
     for (const SolutionSweepRow& row : s.rows) {
         l2.x.push_back(row.eps), l2.y.push_back(row.error.relative_l2);
         max.x.push_back(row.eps), max.y.push_back(row.error.max_relative);
         balance.x.push_back(row.eps), balance.y.push_back(row.balance);
+        per_patch.x.push_back(row.eps), per_patch.y.push_back(row.error.patch_relative_median);
     }
     // Lines join the points in eps order, whatever order they were run in.
-    for (PlotSeries* series : {&l2, &max, &balance}) {
+    for (PlotSeries* series : {&l2, &max, &balance, &per_patch}) {
         std::vector<size_t> order(series->x.size());
         for (size_t k = 0; k < order.size(); ++k) order[k] = k;
         std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return series->x[a] < series->x[b]; });
@@ -290,7 +295,7 @@ SvgPlot solution_error_eps_plot(const SolutionSweep& s, const Scene& scene) {
         for (size_t k = 0; k < order.size(); ++k) sorted.x[k] = series->x[order[k]], sorted.y[k] = series->y[order[k]];
         *series = sorted;
     }
-    p.series = {l2, max, balance};
+    p.series = {l2, max, balance, per_patch};
     if (std::isfinite(r.error_estimate) && r.error_estimate > 0) {
         PlotRefLine floor;
         floor.label = fmt::format("reference's own error (est. {})", sci(r.error_estimate));
@@ -363,12 +368,13 @@ int run_solution_sweep_command(const SweepArgs& args, std::ostream& out, std::os
 
     if (!args.quiet) {
         const Reference& r = sweep.reference;
-        err << fmt::format("  {:>10} {:>10} {:>10} {:>11} {:>11} {:>10} {:>9} {:>9} {:>6}\n", "eps", "vis_eps",
-                           "time_s", "rel. L2", "max rel.", "balance", "elements", "links", "iter");
+        err << fmt::format("  {:>10} {:>10} {:>10} {:>11} {:>11} {:>11} {:>10} {:>9} {:>9} {:>6}\n", "eps", "vis_eps",
+                           "time_s", "rel. L2", "max rel.", "patch med.", "balance", "elements", "links", "iter");
         for (const SolutionSweepRow& row : sweep.rows)
-            err << fmt::format("  {:>10.3g} {:>10.3g} {:>10.3g} {:>11} {:>11} {:>10} {:>9} {:>9} {:>6}\n", row.eps,
-                               row.vis_eps, row.time_s, sci(row.error.relative_l2), sci(row.error.max_relative),
-                               sci(row.balance), row.elements, row.links, row.iterations);
+            err << fmt::format("  {:>10.3g} {:>10.3g} {:>10.3g} {:>11} {:>11} {:>11} {:>10} {:>9} {:>9} {:>6}\n",
+                               row.eps, row.vis_eps, row.time_s, sci(row.error.relative_l2),
+                               sci(row.error.max_relative), sci(row.error.patch_relative_median), sci(row.balance),
+                               row.elements, row.links, row.iterations);
         for (size_t k = 0; k < r.ladder.size(); ++k)
             err << fmt::format("  exact {}: {:.3g} s, relative L2 {}{}\n", mesh(r.ladder_subdivide[k], scene),
                                r.ladder[k].stats.time_s,

@@ -352,7 +352,8 @@ CLI::App* add_sweep_command(CLI::App& app, SweepArgs& a) {
         "length-weighted, all channels, as in compare; the last two each patch's error over its own "
         "reference value). "
         "With --svg PREFIX also PREFIX-error.svg (relative L2 error against run time, log-log, beside the exact "
-        "solver's own error and time) and PREFIX-eps.svg (errors and energy balance against eps). A table goes "
+        "solver's own error and time) and PREFIX-eps.svg (errors, the per-patch median and energy balance against "
+        "eps). A table goes "
         "to stderr unless --quiet, and a progress line while a solve runs when stderr is a terminal.\n"
         "Exit status: 0 done; 2 bad input or bad arguments (one line on stderr); 1 anything else."));
     cmd->add_option("SCENE", a.scene, "Scene file (JSON).")->required()->type_name("FILE");

@@ -335,6 +335,8 @@ TEST_CASE("sweep (whole solutions): CSV rows per eps, errors fall with eps, two 
         CHECK(row[7] > 0);                              // links
         CHECK(row[9] == reference_K);                   // one reference for the whole sweep
         CHECK(row[10] == reference_time);
+        CHECK(row[11] >= 0);       // each patch at its own scale: the median,
+        CHECK(row[12] >= row[11]);  // and the 90th percentile above it
         if (k > 0) CHECK(row[3] <= monotone_slack * csv.rows[k - 1][3]);
     }
     CHECK(csv.rows.back()[3] * min_fall_over_two_decades <= csv.rows.front()[3]);
@@ -353,6 +355,8 @@ TEST_CASE("sweep (whole solutions): CSV rows per eps, errors fall with eps, two 
     const std::string error_svg = read_text(prefix + "-error.svg");
     CHECK(error_svg.find(">0.001</text>") != std::string::npos);
     CHECK(error_svg.find("exact reference time") != std::string::npos);
+    // The eps plot has the per-patch median beside the relative L2.
+    CHECK(read_text(prefix + "-eps.svg").find("per patch |B - R| / R, median") != std::string::npos);
     // Nothing but the three outputs: no temporary file left behind.
     int files = 0;
     for ([[maybe_unused]] const auto& entry : fs::directory_iterator(tmp.dir())) ++files;
