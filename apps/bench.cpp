@@ -1262,7 +1262,7 @@ void run_versus(VersusOptions o, const std::string& cmd) {
         for (const flatrad::PatchErrorShare& q : r.error.largest) top += q.share;
         fmt::print("{:>8g} {:>9.3f} {:>10} {:>10} {:>6} {:>11.3e} {:>11.3e} {:>5.0f}% {:>9.2e} {:>9.2e} {:>9.1f} {:>6}{}\n",
                    r.eps, r.time_s, r.elements, r.links, r.iterations, r.error.relative_l2, r.error.max_relative,
-                   100 * top, r.error.patch_relative_median, r.balance,
+                   100 * top, r.error.patch_relative.median, r.balance,
                    exact_s / r.time_s, ok ? "yes" : "no",
                    fine ? fmt::format(" {:>11.3e}", r.error_2K.relative_l2) : "");
     }

@@ -31,6 +31,10 @@ double max_of(const std::vector<double>& v) {
 // A JSON number, or null when not finite (JSON has no inf or NaN).
 nlohmann::ordered_json number(double v) { return std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json(); }
 
+nlohmann::ordered_json patch_relative_json(const PatchRelative& q) {
+    return {{"median", number(q.median)}, {"p90", number(q.p90)}, {"max", number(q.max)}};
+}
+
 // The error's figures, and where it lies: the patches with the largest
 // shares of the squared error, each with both radiosities.
 nlohmann::ordered_json error_json(const CompareError& e, const Scene& scene, const Solution& solution,
@@ -52,9 +56,7 @@ nlohmann::ordered_json error_json(const CompareError& e, const Scene& scene, con
                            {"reference", r}});
     }
     j["largest"] = largest;
-    j["patch_relative"] = {{"median", number(e.patch_relative_median)},
-                           {"p90", number(e.patch_relative_p90)},
-                           {"max", number(e.patch_relative_max)}};
+    j["patch_relative"] = patch_relative_json(e.patch_relative);
     return j;
 }
 
@@ -173,10 +175,7 @@ int run_compare(const CompareArgs& args, std::ostream& out, std::ostream& err) {
     nlohmann::ordered_json x = {{"subdivide", reference_K}};
     x["error"] = {{"relative_l2", number(estimate)},
                   {"max_relative", number(ref.estimate_max_relative)},
-                  {"patch_relative",
-                   {{"median", number(ref.estimate_patch_relative_median)},
-                    {"p90", number(ref.estimate_patch_relative_p90)},
-                    {"max", number(ref.estimate_patch_relative_max)}}},
+                  {"patch_relative", patch_relative_json(ref.estimate_patch_relative)},
                   {"estimated", true}};
     x.update(run_json(reference));
     x["time_total_s"] = ref.time_total_s;
@@ -203,16 +202,15 @@ int run_compare(const CompareArgs& args, std::ostream& out, std::ostream& err) {
                            fmt::format("eps {:g}", hier.eps), fmt::format("vis_eps {:g}", hier.vis_eps));
         err << fmt::format("  {:<22}{:>18}{:>22}\n", "relative L2 error", sci(h_err.relative_l2),
                            std::isfinite(estimate) ? "<= " + sci(estimate) + " (est.)" : "unknown");
-        err << fmt::format("  {:<22}{:>18}{:>22}\n", "max relative error", sci(h_err.max_relative),
-                           std::isnan(ref.estimate_max_relative) ? "?" : "<= " + sci(ref.estimate_max_relative) + " (est.)");
-        // Each patch at its own scale (the dim ones too).
+        // An estimate of the reference's own error ("?" when there is none).
         auto estimated = [](double v) { return std::isnan(v) ? std::string("?") : "<= " + sci(v) + " (est.)"; };
-        err << fmt::format("  {:<22}{:>18}{:>22}\n", "per patch: median", sci(h_err.patch_relative_median),
-                           estimated(ref.estimate_patch_relative_median));
-        err << fmt::format("  {:<22}{:>18}{:>22}\n", "           90%", sci(h_err.patch_relative_p90),
-                           estimated(ref.estimate_patch_relative_p90));
-        err << fmt::format("  {:<22}{:>18}{:>22}\n", "           max", sci(h_err.patch_relative_max),
-                           estimated(ref.estimate_patch_relative_max));
+        err << fmt::format("  {:<22}{:>18}{:>22}\n", "max relative error", sci(h_err.max_relative),
+                           estimated(ref.estimate_max_relative));
+        // Each patch at its own scale (the dim ones too).
+        const PatchRelative &hq = h_err.patch_relative, &rq = ref.estimate_patch_relative;
+        err << fmt::format("  {:<22}{:>18}{:>22}\n", "per patch: median", sci(hq.median), estimated(rq.median));
+        err << fmt::format("  {:<22}{:>18}{:>22}\n", "           90%", sci(hq.p90), estimated(rq.p90));
+        err << fmt::format("  {:<22}{:>18}{:>22}\n", "           max", sci(hq.max), estimated(rq.max));
         // Where the error lies: the patches with the largest shares of it.
         for (size_t q = 0; q < h_err.largest.size() && q < 3; ++q) {
             const PatchErrorShare& s = h_err.largest[q];

@@ -48,9 +48,7 @@ Reference solve_reference(const Scene& scene, const ReferenceOptions& options,
         const CompareError pair = compare_solutions(scene, coarse, fine);
         ref.error_estimate = pair.relative_l2;
         ref.estimate_max_relative = pair.max_relative;
-        ref.estimate_patch_relative_median = pair.patch_relative_median;
-        ref.estimate_patch_relative_p90 = pair.patch_relative_p90;
-        ref.estimate_patch_relative_max = pair.patch_relative_max;
+        ref.estimate_patch_relative = pair.patch_relative;
         ref.estimate_from_subdivide = K;
         const double judged = compared_error(fine);
         ref.steps.push_back({K, ref.error_estimate, judged});

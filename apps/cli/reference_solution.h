@@ -27,6 +27,7 @@
 #include <string>
 #include <vector>
 
+#include "cli/solution_error.h"
 #include "engine/scene.h"
 #include "solver/solution.h"
 
@@ -77,11 +78,11 @@ struct Reference {
     /// against its finer; +inf (NaN) when no pair was solved.
     double error_estimate = std::numeric_limits<double>::infinity();
     double estimate_max_relative = std::numeric_limits<double>::quiet_NaN();
-    /// The same pair's per-patch relative quantiles (CompareError's
-    /// patch_relative_*): the reference's own error at each patch's scale.
-    double estimate_patch_relative_median = std::numeric_limits<double>::quiet_NaN();
-    double estimate_patch_relative_p90 = std::numeric_limits<double>::quiet_NaN();
-    double estimate_patch_relative_max = std::numeric_limits<double>::quiet_NaN();
+    /// The same pair's CompareError::patch_relative: the reference's own
+    /// error at each patch's scale (NaN when no pair was solved).
+    PatchRelative estimate_patch_relative{std::numeric_limits<double>::quiet_NaN(),
+                                          std::numeric_limits<double>::quiet_NaN(),
+                                          std::numeric_limits<double>::quiet_NaN()};
     long estimate_from_subdivide = 0;  ///< K of that coarser solve; 0 when none
     bool reached = false;              ///< error_estimate <= compared error / reference_margin
     std::string stopped;               ///< why the doubling stopped short; empty when reached

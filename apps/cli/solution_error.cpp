@@ -48,33 +48,29 @@ CompareError compare_solutions(const Scene& scene, const Solution& solution, con
     }
     const double inf = std::numeric_limits<double>::infinity();
     e.relative_l2 = diff2 == 0 ? 0 : (ref2 > 0 ? static_cast<double>(std::sqrt(diff2 / ref2)) : inf);
-    for (size_t p = 0; p < scene.patches.size(); ++p)
-        for (int c = 0; c < C; ++c) {
-            const double rms = length > 0 ? static_cast<double>(std::sqrt(ref2_c[static_cast<size_t>(c)] / length)) : 0;
-            const double d = std::abs(solution.patches[p].radiosity[static_cast<size_t>(c)] -
-                                      reference.patches[p].radiosity[static_cast<size_t>(c)]);
-            const double rel = d == 0 ? 0 : (rms > 0 ? d / rms : inf);
-            if (e.worst_patch < 0 || rel > e.max_relative || std::isnan(rel)) {
-                e.max_relative = std::isnan(rel) ? inf : rel;
-                e.worst_patch = static_cast<int>(p);
-            }
-        }
-    if (e.max_relative == 0) e.worst_patch = -1;
-    // Each patch at its own scale: length-weighted quantiles of q_pc.
+    // Each difference at the scene's scale (max_relative) and at its own
+    // patch's (q_pc, length-weighted quantiles below).
     struct Weighted {
         double q, length;
     };
     std::vector<Weighted> q;
     q.reserve(scene.patches.size() * static_cast<size_t>(C));
-    long double total = 0;
+    long double total = 0;  // their weights' sum
     for (size_t p = 0; p < scene.patches.size(); ++p)
         for (int c = 0; c < C; ++c) {
+            const double rms = length > 0 ? static_cast<double>(std::sqrt(ref2_c[static_cast<size_t>(c)] / length)) : 0;
             const double r = reference.patches[p].radiosity[static_cast<size_t>(c)];
             const double d = std::abs(solution.patches[p].radiosity[static_cast<size_t>(c)] - r);
-            const double rel = d == 0 ? 0 : (r != 0 ? d / std::abs(r) : inf);
-            q.push_back({std::isnan(rel) ? inf : rel, scene.patches[p].length});
+            const double rel = d == 0 ? 0 : (rms > 0 ? d / rms : inf);
+            if (e.worst_patch < 0 || rel > e.max_relative || std::isnan(rel)) {
+                e.max_relative = std::isnan(rel) ? inf : rel;
+                e.worst_patch = static_cast<int>(p);
+            }
+            const double own = d == 0 ? 0 : (r != 0 ? d / std::abs(r) : inf);
+            q.push_back({std::isnan(own) ? inf : own, scene.patches[p].length});
             total += scene.patches[p].length;
         }
+    if (e.max_relative == 0) e.worst_patch = -1;
     if (!q.empty()) {
         std::sort(q.begin(), q.end(), [](const Weighted& a, const Weighted& b) { return a.q < b.q; });
         auto quantile = [&](double share) {
@@ -85,9 +81,7 @@ CompareError compare_solutions(const Scene& scene, const Solution& solution, con
             }
             return q.back().q;  // (rounding of the running sum)
         };
-        e.patch_relative_median = quantile(0.5);
-        e.patch_relative_p90 = quantile(0.9);
-        e.patch_relative_max = q.back().q;
+        e.patch_relative = {quantile(0.5), quantile(0.9), q.back().q};
     }
     return e;
 }

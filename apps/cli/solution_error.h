@@ -17,7 +17,7 @@
 ///   q_pc = |B_pc - R_pc| / R_pc   (0 where both are 0, +inf where only
 ///                                  R_pc is),
 /// is summarised by its length-weighted quantiles over patches and
-/// channels (patch_relative_*): how well each surface is known, the dim
+/// channels (patch_relative): how well each surface is known, the dim
 /// ones included (a forest's shade, whose errors of 10x and more the
 /// relative L2 of 1% at its lamp does not show).
 #include <vector>
@@ -34,6 +34,13 @@ struct PatchErrorShare {
     double share = 0;
 };
 
+/// q_pc (above) summarised: its length-weighted median, its 90th
+/// percentile (the least q with at least that share of the length at or
+/// below it) and its largest.
+struct PatchRelative {
+    double median = 0, p90 = 0, max = 0;
+};
+
 /// Where the error lies: how many patches `largest` lists at most.
 inline constexpr int largest_error_patches = 5;
 
@@ -47,10 +54,8 @@ struct CompareError {
     /// L2 error dominated by a few patches is told apart from one spread
     /// over the scene (a forest's lit trees next to its lamp, say).
     std::vector<PatchErrorShare> largest;
-    /// q_pc above: the length-weighted median, the 90th percentile (the
-    /// least q with at least that share of the length at or below it) and
-    /// the largest; 0 with no patch.
-    double patch_relative_median = 0, patch_relative_p90 = 0, patch_relative_max = 0;
+    /// Each patch at its own scale (q_pc above); all 0 with no patch.
+    PatchRelative patch_relative;
 };
 
 /// Errors of `solution` against `reference`, two solves of `scene` (same

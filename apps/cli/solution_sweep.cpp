@@ -210,8 +210,8 @@ std::string solution_sweep_csv(const SolutionSweep& s, const Scene& scene) {
     for (const SolutionSweepRow& row : s.rows)
         csv += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{}\n", row.eps, row.vis_eps, row.time_s,
                            row.error.relative_l2, row.error.max_relative, row.balance, row.elements, row.links,
-                           row.iterations, r.subdivide(), ref.stats.time_s, row.error.patch_relative_median,
-                           row.error.patch_relative_p90);
+                           row.iterations, r.subdivide(), ref.stats.time_s, row.error.patch_relative.median,
+                           row.error.patch_relative.p90);
     return csv;
 }
 
@@ -284,7 +284,7 @@ SvgPlot solution_error_eps_plot(const SolutionSweep& s, const Scene& scene) {
         l2.x.push_back(row.eps), l2.y.push_back(row.error.relative_l2);
         max.x.push_back(row.eps), max.y.push_back(row.error.max_relative);
         balance.x.push_back(row.eps), balance.y.push_back(row.balance);
-        per_patch.x.push_back(row.eps), per_patch.y.push_back(row.error.patch_relative_median);
+        per_patch.x.push_back(row.eps), per_patch.y.push_back(row.error.patch_relative.median);
     }
     // Lines join the points in eps order, whatever order they were run in.
     for (PlotSeries* series : {&l2, &max, &balance, &per_patch}) {
@@ -373,7 +373,7 @@ int run_solution_sweep_command(const SweepArgs& args, std::ostream& out, std::os
         for (const SolutionSweepRow& row : sweep.rows)
             err << fmt::format("  {:>10.3g} {:>10.3g} {:>10.3g} {:>11} {:>11} {:>11} {:>10} {:>9} {:>9} {:>6}\n",
                                row.eps, row.vis_eps, row.time_s, sci(row.error.relative_l2),
-                               sci(row.error.max_relative), sci(row.error.patch_relative_median), sci(row.balance),
+                               sci(row.error.max_relative), sci(row.error.patch_relative.median), sci(row.balance),
                                row.elements, row.links, row.iterations);
         for (size_t k = 0; k < r.ladder.size(); ++k)
             err << fmt::format("  exact {}: {:.3g} s, relative L2 {}{}\n", mesh(r.ladder_subdivide[k], scene),

@@ -190,9 +190,9 @@ TEST_CASE("compare_solutions: each patch at its own scale, by length-weighted qu
     const flatrad::Solution a = flatrad::solve_exact(scene, {2, 0});
     for (const auto& p : a.patches) REQUIRE(p.radiosity[0] > 0);  // (every patch lit: q is finite)
     const flatrad::CompareError same = flatrad::compare_solutions(scene, a, a);
-    CHECK(same.patch_relative_median == 0);
-    CHECK(same.patch_relative_p90 == 0);
-    CHECK(same.patch_relative_max == 0);
+    CHECK(same.patch_relative.median == 0);
+    CHECK(same.patch_relative.p90 == 0);
+    CHECK(same.patch_relative.max == 0);
     // Every patch 10% high but one, k, 3x high: the median is 0.1 whatever
     // the brightness (the relative L2 is not), the max 2; the 90th
     // percentile is 2 exactly when k holds more than a tenth of the length.
@@ -208,16 +208,16 @@ TEST_CASE("compare_solutions: each patch at its own scale, by length-weighted qu
         for (size_t p = 0; p < b.patches.size(); ++p) b.patches[p].radiosity[0] *= p == k ? 3.0 : 1.1;
         const flatrad::CompareError e = flatrad::compare_solutions(scene, b, a);
         REQUIRE(scene.patches[k].length < 0.5 * total);
-        CHECK(e.patch_relative_median == doctest::Approx(0.1).epsilon(rounding));
-        CHECK(e.patch_relative_max == doctest::Approx(2.0).epsilon(rounding));
-        CHECK(e.patch_relative_p90 == doctest::Approx(scene.patches[k].length > 0.1 * total ? 2.0 : 0.1).epsilon(rounding));
+        CHECK(e.patch_relative.median == doctest::Approx(0.1).epsilon(rounding));
+        CHECK(e.patch_relative.max == doctest::Approx(2.0).epsilon(rounding));
+        CHECK(e.patch_relative.p90 == doctest::Approx(scene.patches[k].length > 0.1 * total ? 2.0 : 0.1).epsilon(rounding));
         // Scale-free: both solutions times 1000, the same quantiles.
         flatrad::Solution a2 = a, b2 = b;
         for (auto& p : a2.patches) p.radiosity[0] *= 1000;
         for (auto& p : b2.patches) p.radiosity[0] *= 1000;
         const flatrad::CompareError e2 = flatrad::compare_solutions(scene, b2, a2);
-        CHECK(e2.patch_relative_median == doctest::Approx(e.patch_relative_median).epsilon(rounding));
-        CHECK(e2.patch_relative_p90 == doctest::Approx(e.patch_relative_p90).epsilon(rounding));
+        CHECK(e2.patch_relative.median == doctest::Approx(e.patch_relative.median).epsilon(rounding));
+        CHECK(e2.patch_relative.p90 == doctest::Approx(e.patch_relative.p90).epsilon(rounding));
     }
     CHECK(over_tenth == 1);   // the floor, 1 of 4.8
     CHECK(under_tenth == 1);  // a pillar side, 0.2 of 4.8
@@ -225,10 +225,10 @@ TEST_CASE("compare_solutions: each patch at its own scale, by length-weighted qu
     // (the max) where it is not.
     flatrad::Solution dark = a;
     dark.patches[3].radiosity[0] = 0;
-    CHECK(flatrad::compare_solutions(scene, dark, dark).patch_relative_max == 0);
+    CHECK(flatrad::compare_solutions(scene, dark, dark).patch_relative.max == 0);
     flatrad::Solution lit = dark;
     lit.patches[3].radiosity[0] = 0.5;
-    CHECK(std::isinf(flatrad::compare_solutions(scene, lit, dark).patch_relative_max));
+    CHECK(std::isinf(flatrad::compare_solutions(scene, lit, dark).patch_relative.max));
     fs::remove(path);
 }
 
