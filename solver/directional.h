@@ -116,6 +116,19 @@ inline void add_cosine_lobe(double* samples, double* linear, Vec2 n, double w) {
     linear[1] += w * n.y;
 }
 
+/// The same with the samples' terms scaled per bin by `scale` (not null).
+inline void add_cosine_lobe(double* samples, double* linear, Vec2 n, double w, const double* scale) {
+    if (samples) {
+        const auto& d = bin_directions();
+        for (int k = 0; k < directional_bins; ++k) {
+            const double c = n.x * d[static_cast<size_t>(k)].x + n.y * d[static_cast<size_t>(k)].y;
+            samples[k] += w * scale[k] * std::max(c, 0.0);
+        }
+    }
+    linear[0] += w * n.x;
+    linear[1] += w * n.y;
+}
+
 /// The same on a table of directional_table_width doubles.
 inline void add_cosine_lobe(double* table, Vec2 n, double w) {
     add_cosine_lobe(table, table + directional_bins, n, w);
@@ -131,6 +144,19 @@ inline double read_cosine_lobe(const double* samples, const double* linear, Vec2
         for (int k = 0; k < directional_bins; ++k) {
             const double c = n.x * d[static_cast<size_t>(k)].x + n.y * d[static_cast<size_t>(k)].y;
             s += samples[k] * std::max(c, 0.0);
+        }
+    }
+    return s + n.x * linear[0] + n.y * linear[1];
+}
+
+/// The same with the samples scaled per bin by `scale` (not null).
+inline double read_cosine_lobe(const double* samples, const double* linear, Vec2 n, const double* scale) {
+    double s = 0;
+    if (samples) {
+        const auto& d = bin_directions();
+        for (int k = 0; k < directional_bins; ++k) {
+            const double c = n.x * d[static_cast<size_t>(k)].x + n.y * d[static_cast<size_t>(k)].y;
+            s += scale[k] * samples[k] * std::max(c, 0.0);
         }
     }
     return s + n.x * linear[0] + n.y * linear[1];

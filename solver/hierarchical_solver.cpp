@@ -473,6 +473,27 @@ public:
         if (o.closure_screens) m_screen_depth = m_vis.long_shaft_depth();
         m_unblockable = std::find(blockers.begin(), blockers.end(), 1) == blockers.end();
         m_kappa = m_vis.layers_per_depth();
+        if (m_kappa > 0) {
+            // Per hierarchy node: the layers of shadow per unit of depth of
+            // the blockers inside its box that are not its members (boxes
+            // overlap): the scene's density less the members' own, at
+            // least 0 (prior_transmittance).
+            const auto& order = m_hierarchy.order();
+            std::vector<double> prefix(order.size() + 1, 0.0);
+            for (size_t k = 0; k < order.size(); ++k) {
+                const int sg = order[k];
+                prefix[k + 1] = prefix[k] + (m_hierarchy.can_block(sg) ? m_scene.segments[static_cast<size_t>(sg)].seg.length() : 0.0);
+            }
+            m_foreign_kappa.assign(m_hierarchy.nodes().size(), 0.0);
+            for (size_t h = 0; h < m_hierarchy.nodes().size(); ++h) {
+                const ClusterNode& c = m_hierarchy.nodes()[h];
+                const OrientedBox& b = m_obox[h];
+                const double area = (b.hi_u - b.lo_u) * (b.hi_v - b.lo_v);
+                const double own = prefix[static_cast<size_t>(c.first + c.count)] - prefix[static_cast<size_t>(c.first)];
+                const double own_kappa = area > 0 ? 2 / std::numbers::pi * own / area : std::numeric_limits<double>::infinity();
+                m_foreign_kappa[h] = std::max(0.0, m_kappa - own_kappa);
+            }
+        }
         if (m_opt.emission_first && !m_unblockable && m_hierarchy.root() >= 0) {
             const Vec2 e = m_hierarchy.node(m_hierarchy.root()).box.extent();
             m_emission_first = m_kappa * std::max(e.x, e.y) >= emission_first_layers;
@@ -531,13 +552,11 @@ private:
     void build_tree();
     void mark_chains();
     void self_occlusion();
-    // Scales table t's samples by its beta (self_occlusion), if it has any.
-    void scale_by_beta(TableArray& tables, int t) const {
-        if (m_beta.empty()) return;
-        double* x = tables.samples(t);
-        if (!x) return;
-        const double* beta = &m_beta[static_cast<size_t>(t) * directional_bins];
-        for (int b = 0; b < directional_bins; ++b) x[b] *= beta[b];
+    // Node k's share seen from outside its parent (self_occlusion), per
+    // direction bin; null where it is 1 in every bin.
+    const double* gamma(size_t k) const {
+        if (k >= m_gamma_slot.size() || m_gamma_slot[k] < 0) return nullptr;
+        return &m_gamma[static_cast<size_t>(m_gamma_slot[k]) * directional_bins];
     }
     bool hidden_below(const Node& n) const { return !m_hidden_below.empty() && m_hidden_below[static_cast<size_t>(n.table)]; }
     bool chain_ends(const Node& n, ChainEnds& out) const;
@@ -598,6 +617,7 @@ private:
     double m_vis_eps = 0;
     bool m_unblockable = false;
     double m_kappa = 0;  // the scene's layers of shadow per unit of depth (prior_transmittance)
+    std::vector<double> m_foreign_kappa;  // per hierarchy node (prior_transmittance)
     bool m_emission_first = false;  // the first round against the emission alone (run; emission_first_layers)
     // A closed convex room whose patches all reflect or emit: once anything
     // emits, every patch is reached and the scene is one part (solve()).
@@ -652,12 +672,15 @@ private:
     int m_root = -1;
     int m_tables_count = 0;
     std::vector<double> m_sensitivity;  // per cluster table: sum L cos+(n . u(psi_k)), seen from outside
-    // Occlusion inside clusters (self_occlusion): per table and direction
-    // bin, the factor beta by which the table scales what its children
-    // pull up and what it pushes down (empty: none anywhere); per table,
-    // whether beta < 1 at it or below (its linear part is not read); the
+    // Occlusion inside clusters (self_occlusion): per node under a table
+    // (a cluster or a leaf cluster), its slot in m_gamma (-1: none, the
+    // factor is 1), where per direction bin the factor gamma by which what
+    // it pulls up into its parent's table and what it gets from that table
+    // are scaled (all empty: no occlusion anywhere); per table, whether
+    // some gamma < 1 below it (its linear part is not read); the
     // sensitivity before the factors (the link error's `layered` term).
-    std::vector<double> m_beta;
+    std::vector<int32_t> m_gamma_slot;
+    std::vector<double> m_gamma;
     std::vector<char> m_hidden_below;
     std::vector<double> m_sensitivity_all;
     LinkVector m_links;
@@ -944,19 +967,33 @@ void HierarchicalSolver::build_tree() {
 
 // Occlusion inside clusters (solver/self_occlusion.h). Per table cluster,
 // per direction bin: A, the share of its members' lobes seen from outside
-// it (visible_fraction), so that its sensitivity is A x the lobes' sum.
-// The operator applies it level by level: a table's beta is its
-// sensitivity over the sum of its children's, and it scales the exitance
-// the children pull up into it and the arrivals it pushes down to them
-// (pull_tables, push_down), the same factor both ways, so that the
-// operator keeps its adjoint (landed_fraction) and a cluster delivers to
-// its members exactly what its sensitivity says it receives.
+// it (visible_fraction), so that its sensitivity is A x the lobes' sum;
+// and, per child, the share of that child's lobes seen from outside the
+// cluster (the same depth buffer, by groups). The operator applies it edge
+// by edge: a child's gamma is its share seen from outside its parent over
+// its share seen from outside itself (what its own table already counts),
+// and it scales the exitance the child pulls up into its parent's table
+// and the arrivals it takes from there (pull_tables, push_down), the same
+// factor both ways, so that the operator keeps its adjoint
+// (landed_fraction) and a cluster delivers to its members what its
+// sensitivity says it receives: sum over children of gamma x their
+// sensitivity, A x the lobes' sum.
+//
+// Per child, not one factor per cluster: a cluster's arrivals go to the
+// children in view along their direction, not evenly to all of them (one
+// factor per cluster gave a forest's members behind others the same
+// light as those in front, and its shade, lit through cluster links, far
+// too much; docs/solver-history.md, "Twenty-fourth session"). What is
+// still spread evenly is each child's share among its own members, down
+// to the next level, where the next gamma sorts them again.
+//
 // Not where nothing can block (a convex room: the tables are exact) nor for
 // chains (arcs of a convex loop, lit on the room's side, whose partners
 // lie inside the loop: seen from there, no side hides another, while the
 // view from far along a direction, from outside the loop, would).
 void HierarchicalSolver::self_occlusion() {
-    m_beta.clear();
+    m_gamma_slot.clear();
+    m_gamma.clear();
     m_hidden_below.clear();
     m_sensitivity_all.clear();
     if (m_unblockable || m_tables_count == 0) return;
@@ -967,34 +1004,71 @@ void HierarchicalSolver::self_occlusion() {
         const ClusterNode& c = m_hierarchy.node(n.hnode);
         if (c.count >= 2 && c.blockers >= 1) clusters.push_back(static_cast<int>(k));
     }
+    // Every child of those clusters gets a slot; a cluster's children's
+    // slots are consecutive.
+    std::vector<int32_t> slot(m_nodes.size(), -1);
+    int32_t slots = 0;
+    for (int k : clusters) {
+        const Node& n = m_nodes[static_cast<size_t>(k)];
+        for (int ch = n.child; ch < n.child + n.nchild; ++ch) slot[static_cast<size_t>(ch)] = slots++;
+    }
     std::vector<double> A(static_cast<size_t>(m_tables_count) * K, 1.0);
+    std::vector<double> seen(static_cast<size_t>(slots) * K, 1.0);  // per child: its lobes' share seen from outside its parent
     const long C = static_cast<long>(clusters.size());
 #pragma omp parallel for num_threads(m_threads) schedule(dynamic, 4)
     for (long q = 0; q < C; ++q) {
         const Node& n = m_nodes[static_cast<size_t>(clusters[static_cast<size_t>(q)])];
-        const ClusterNode& c = m_hierarchy.node(n.hnode);
         thread_local std::vector<Segment> segs;
         thread_local std::vector<uint8_t> sides;
+        thread_local std::vector<int32_t> group;
         segs.clear();
         sides.clear();
-        for (int32_t k = c.first; k < c.first + c.count; ++k) {
-            const size_t s = static_cast<size_t>(m_hierarchy.order()[static_cast<size_t>(k)]);
-            const SceneSegment& ss = m_scene.segments[s];
-            uint8_t has = 0;
-            if (ss.lit_left || m_visible_sink[2 * s]) has |= left_side;
-            if (ss.lit_right || m_visible_sink[2 * s + 1]) has |= right_side;
-            if (m_hierarchy.can_block(static_cast<int>(s))) has |= blocks;
-            segs.push_back(ss.seg);
-            sides.push_back(has);
+        group.clear();
+        // The members child by child (the children's ranges make up the
+        // cluster's).
+        for (int g = 0; g < n.nchild; ++g) {
+            const Node& child = m_nodes[static_cast<size_t>(n.child + g)];
+            FLATRAD_ASSERT(child.cluster(), "a table cluster's children are clusters");
+            const ClusterNode& c = m_hierarchy.node(child.hnode);
+            for (int32_t k = c.first; k < c.first + c.count; ++k) {
+                const size_t s = static_cast<size_t>(m_hierarchy.order()[static_cast<size_t>(k)]);
+                const SceneSegment& ss = m_scene.segments[s];
+                uint8_t has = 0;
+                if (ss.lit_left || m_visible_sink[2 * s]) has |= left_side;
+                if (ss.lit_right || m_visible_sink[2 * s + 1]) has |= right_side;
+                if (m_hierarchy.can_block(static_cast<int>(s))) has |= blocks;
+                segs.push_back(ss.seg);
+                sides.push_back(has);
+                group.push_back(g);
+            }
         }
-        visible_fraction(segs.data(), sides.data(), segs.size(), &A[static_cast<size_t>(n.table) * K]);
+        FLATRAD_ASSERT(static_cast<int32_t>(segs.size()) == m_hierarchy.node(n.hnode).count,
+                       "a cluster's children hold its members");
+        visible_fraction(segs.data(), sides.data(), segs.size(), &A[static_cast<size_t>(n.table) * K], group.data(),
+                         n.nchild, &seen[static_cast<size_t>(slot[static_cast<size_t>(n.child)]) * K]);
     }
     if (std::all_of(A.begin(), A.end(), [](double a) { return a == 1.0; })) return;
     m_sensitivity_all = m_sensitivity;
-    m_beta.assign(static_cast<size_t>(m_tables_count) * K, 1.0);
     m_hidden_below.assign(static_cast<size_t>(m_tables_count), 0);
-    // Children before parents: a table's sensitivity becomes A x its lobes'
-    // sum, as beta x the sum of its children's (final) sensitivities.
+    // gamma = seen from outside the parent over seen from outside itself
+    // (a leaf cluster has no table: its own share is 1), at most 1 (the
+    // two are measured on different lines, and what is seen from outside
+    // the parent is seen from outside the child); 1 where the child shows
+    // nothing along that bin anyway.
+    for (int k : clusters) {
+        const Node& n = m_nodes[static_cast<size_t>(k)];
+        for (int ch = n.child; ch < n.child + n.nchild; ++ch) {
+            const Node& c = m_nodes[static_cast<size_t>(ch)];
+            double* g = &seen[static_cast<size_t>(slot[static_cast<size_t>(ch)]) * K];
+            if (c.table < 0) continue;
+            const double* own = &A[static_cast<size_t>(c.table) * K];
+            for (int b = 0; b < K; ++b) g[b] = own[b] > 0 ? std::min(1.0, g[b] / own[b]) : 1.0;
+        }
+    }
+    m_gamma = std::move(seen);
+    m_gamma_slot = std::move(slot);
+    // Children before parents: a table's sensitivity becomes the sum of
+    // its children's (final) sensitivities, each times its gamma.
     double sum[K];
     for (size_t k = m_nodes.size(); k-- > 0;) {
         const Node& n = m_nodes[k];
@@ -1003,31 +1077,22 @@ void HierarchicalSolver::self_occlusion() {
         bool hidden = false;
         for (int ch = n.child; ch < n.child + n.nchild; ++ch) {
             const Node& c = m_nodes[static_cast<size_t>(ch)];
+            const double* g = gamma(static_cast<size_t>(ch));
+            if (g)
+                for (int b = 0; b < K; ++b) hidden = hidden || g[b] < 1;
             if (c.table >= 0) {
                 const double* sc = &m_sensitivity[static_cast<size_t>(c.table) * TW];
-                for (int b = 0; b < K; ++b) sum[b] += sc[b];
+                for (int b = 0; b < K; ++b) sum[b] += (g ? g[b] : 1.0) * sc[b];
                 hidden = hidden || m_hidden_below[static_cast<size_t>(c.table)];
             } else if (c.leaf_cluster) {
                 double lobes[TW] = {};
                 for (int sd = c.child; sd < c.child + c.nchild; ++sd)
                     add_cosine_lobe(lobes, m_nodes[static_cast<size_t>(sd)].normal, m_nodes[static_cast<size_t>(sd)].length);
-                for (int b = 0; b < K; ++b) sum[b] += lobes[b];
+                for (int b = 0; b < K; ++b) sum[b] += (g ? g[b] : 1.0) * lobes[b];
             }
         }
         double* S = &m_sensitivity[static_cast<size_t>(n.table) * TW];
-        const double* a = &A[static_cast<size_t>(n.table) * K];
-        double* beta = &m_beta[static_cast<size_t>(n.table) * K];
-        for (int b = 0; b < K; ++b) {
-            const double target = a[b] * m_sensitivity_all[static_cast<size_t>(n.table) * TW + static_cast<size_t>(b)];
-            // Nothing hidden inside this cluster (A = 1): its children's
-            // sum is at most its lobes' (equal but for rounding when none
-            // is hidden either: a leaf's sides summed in another order), so
-            // beta is 1 exactly, not 1 - 1e-16, which would mark the table
-            // hidden and keep every link from reading its linear part.
-            beta[b] = a[b] < 1 && sum[b] > 0 ? std::min(1.0, target / sum[b]) : 1.0;
-            S[b] = beta[b] * sum[b];
-            hidden = hidden || beta[b] < 1;
-        }
+        for (int b = 0; b < K; ++b) S[b] = sum[b];
         m_hidden_below[static_cast<size_t>(n.table)] = hidden ? 1 : 0;
     }
 }
@@ -1393,8 +1458,14 @@ double HierarchicalSolver::prior_transmittance(const Node& r, const Node& s) con
         const double a = dot(n.seg.a - s.center, u), b = dot(n.seg.b - s.center, u);
         return std::make_pair(std::min(a, b), std::max(a, b));
     };
-    const double gap = std::max(0.0, range(r).first - range(s).second);
-    return std::exp(-m_kappa * gap);
+    const auto rr = range(r), rs = range(s);
+    const double gap = std::max(0.0, rr.first - rs.second);
+    double depth = m_kappa * gap;
+    if (!m_foreign_kappa.empty()) {
+        if (r.cluster()) depth += m_foreign_kappa[static_cast<size_t>(r.hnode)] * 0.5 * (rr.second - rr.first);
+        if (s.cluster()) depth += m_foreign_kappa[static_cast<size_t>(s.hnode)] * 0.5 * (rs.second - rs.first);
+    }
+    return std::exp(-depth);
 }
 
 // A cluster link's coefficient at tau = 1 (see Link).
@@ -1757,13 +1828,13 @@ void HierarchicalSolver::pull_node(size_t k, const double* leaf_value, std::vect
                 power += m_op[static_cast<size_t>(c)].length * Bn[static_cast<size_t>(c)];
             Bn[k] = power / n.length;
         }
-        // A table is whole once its children are in: scaled for what its
-        // own members hide (also a part's top, whose links read it).
-        if (n.kind == Kind::Cluster && n.table >= 0) scale_by_beta(I, n.table);
     }
     if (!up || n.kind != Kind::Cluster || n.up_table < 0 || !in_part(part, static_cast<int>(k), n.parent)) return;
+    // What leaves the parent from this node: its share seen from outside
+    // the parent (gamma, self_occlusion).
+    const double* g = gamma(k);
     if (n.table >= 0) {
-        I.sum_child(n.up_table, n.table);
+        I.sum_child(n.up_table, n.table, g);
     } else if (n.leaf_cluster) {
         double* samples = I.samples(n.up_table);
         double* linear = I.linear(n.up_table);
@@ -1771,7 +1842,11 @@ void HierarchicalSolver::pull_node(size_t k, const double* leaf_value, std::vect
             const OpNode& side = m_op[static_cast<size_t>(c)];
             if (side.kind != Kind::Element) continue;
             const double w = 0.5 * side.length * Bn[static_cast<size_t>(c)];
-            if (w != 0) add_cosine_lobe(samples, linear, side.normal, w);
+            if (w == 0) continue;
+            if (g)
+                add_cosine_lobe(samples, linear, side.normal, w, g);
+            else
+                add_cosine_lobe(samples, linear, side.normal, w);
         }
     }
 }
@@ -2475,19 +2550,20 @@ void HierarchicalSolver::push_node(size_t k, TableArray& tables, const std::vect
                                    std::vector<double>& above, const Part* part) const {
     const OpNode& n = m_op[k];
     above[k] = 0;
-    if (n.parent < 0 || !in_part(part, static_cast<int>(k), n.parent)) {
-        if (n.table >= 0) scale_by_beta(tables, n.table);  // a top: what arrived, to its children
-        return;
-    }
+    if (n.parent < 0 || !in_part(part, static_cast<int>(k), n.parent)) return;
     // What reached the parent evenly (an element's own links, chain
     // links to clusters above) reaches every node below.
     above[k] = own[static_cast<size_t>(n.parent)] + above[static_cast<size_t>(n.parent)];
     if (n.kind == Kind::Cluster) {
-        if (n.table >= 0 && n.up_table >= 0) tables.add_parent(n.table, n.up_table);
-        if (n.table >= 0) scale_by_beta(tables, n.table);
+        // The parent's arrivals, at this node's share seen from outside it.
+        if (n.table >= 0 && n.up_table >= 0) tables.add_parent(n.table, n.up_table, gamma(k));
     } else if (n.side && n.up_table >= 0) {
-        // Its leaf cluster: no link ends there, its table is its parent's.
-        above[k] += lobe_scale * read_cosine_lobe(tables.samples(n.up_table), tables.linear(n.up_table), n.normal);
+        // Its leaf cluster: no link ends there, its table is its parent's,
+        // read at the leaf cluster's share seen from outside that parent.
+        const double* g = gamma(static_cast<size_t>(n.parent));
+        const double* samples = tables.samples(n.up_table);
+        const double* linear = tables.linear(n.up_table);
+        above[k] += lobe_scale * (g ? read_cosine_lobe(samples, linear, n.normal, g) : read_cosine_lobe(samples, linear, n.normal));
     }
 }
 

@@ -28,7 +28,8 @@ Facing facing_ways(const Segment& s, uint8_t has, Vec2 u) {
 // midpoint decides). O(n^2) per direction, both directions of a line at
 // once: bins k and k + K/2 look along u and -u, where each pair's overlap
 // is the same and the front one along u is the back one along -u.
-void visible_fraction_exact(const Segment* segs, const uint8_t* sides, size_t n, double out[directional_bins]) {
+void visible_fraction_exact(const Segment* segs, const uint8_t* sides, size_t n, double out[directional_bins],
+                            const int32_t* group, double* gseen, double* gall) {
     static_assert(directional_bins % 2 == 0, "bin k + K/2 looks along -u");
     constexpr int half = directional_bins / 2;
     struct Proj {
@@ -85,8 +86,14 @@ void visible_fraction_exact(const Segment* segs, const uint8_t* sides, size_t n,
             }
             for (int w = 0; w < 2; ++w)
                 if (a.facing[w]) {
-                    all[w] += a.hi - a.lo;
-                    seen[w] += uncovered(a.lo, a.hi, hidden[w]);
+                    const double width = a.hi - a.lo, visible = uncovered(a.lo, a.hi, hidden[w]);
+                    all[w] += width;
+                    seen[w] += visible;
+                    if (group) {
+                        const size_t at = static_cast<size_t>(group[i]) * directional_bins + static_cast<size_t>(k + w * half);
+                        gall[at] += width;
+                        gseen[at] += visible;
+                    }
                 }
         }
         for (int w = 0; w < 2; ++w) {
@@ -98,10 +105,15 @@ void visible_fraction_exact(const Segment* segs, const uint8_t* sides, size_t n,
 
 }  // namespace
 
-void visible_fraction(const Segment* segs, const uint8_t* sides, size_t n, double out[directional_bins], int lines) {
+namespace {
+
+// Both visible_fraction()s: with `group`, also each group's seen and
+// facing lobes per bin (gseen, gall: groups x K, zeroed by the caller).
+void measure(const Segment* segs, const uint8_t* sides, size_t n, double out[directional_bins], int lines,
+             const int32_t* group, double* gseen, double* gall) {
     std::fill(out, out + directional_bins, 1.0);
     if (n < 2) return;  // one segment cannot hide itself
-    if (lines == 0 && n <= exact_up_to) return visible_fraction_exact(segs, sides, n, out);
+    if (lines == 0 && n <= exact_up_to) return visible_fraction_exact(segs, sides, n, out, group, gseen, gall);
     const int M = lines > 0 ? lines : static_cast<int>(std::clamp<size_t>(2 * n, 64, 1024));
     const size_t Ms = static_cast<size_t>(M);
     // Bins k and k + K/2 look along u and -u: the same lines across, each
@@ -115,8 +127,9 @@ void visible_fraction(const Segment* segs, const uint8_t* sides, size_t n, doubl
     constexpr int half = directional_bins / 2;
     thread_local std::vector<double> depth[2];
     thread_local std::vector<uint8_t> front[2];
-    thread_local std::vector<int32_t> count[2], passive[2];
+    thread_local std::vector<int32_t> count[2], passive[2], front_of[2];
     for (int w = 0; w < 2; ++w) {
+        front_of[w].resize(Ms);
         depth[w].resize(Ms);
         front[w].resize(Ms);
         count[w].resize(Ms);
@@ -172,6 +185,8 @@ void visible_fraction(const Segment* segs, const uint8_t* sides, size_t n, doubl
                 const double slope = span > 0 ? (db - da) / span : 0.0;
                 const double d_lo = span > 0 ? da + (lo + 0.5 * wl - pa) * slope : 0.5 * (da + db);
                 const double d_step = wl * slope;
+                const int32_t me = static_cast<int32_t>(i);
+                long seen_here[2] = {0, 0};
                 for (int j = j0; j <= j1; ++j) {
                     const size_t js = static_cast<size_t>(j);
                     const double d = d_lo + j * d_step;
@@ -181,14 +196,27 @@ void visible_fraction(const Segment* segs, const uint8_t* sides, size_t n, doubl
                         if (d > depth[0][js]) {
                             depth[0][js] = d;
                             front[0][js] = facing[0];
+                            front_of[0][js] = me;
                         }
                         if (d < depth[1][js]) {
                             depth[1][js] = d;
                             front[1][js] = facing[1];
+                            front_of[1][js] = me;
                         }
                     } else {
-                        passive[0][js] += facing[0] && d >= depth[0][js];
-                        passive[1][js] += facing[1] && d <= depth[1][js];
+                        const bool s0 = facing[0] && d >= depth[0][js], s1 = facing[1] && d <= depth[1][js];
+                        passive[0][js] += s0;
+                        passive[1][js] += s1;
+                        seen_here[0] += s0;
+                        seen_here[1] += s1;
+                    }
+                }
+                if (group && j1 >= j0) {
+                    const size_t g = static_cast<size_t>(group[i]) * directional_bins;
+                    for (int w = 0; w < 2; ++w) {
+                        const size_t at = g + static_cast<size_t>(k + w * half);
+                        gall[at] += facing[w] ? j1 - j0 + 1 : 0;
+                        gseen[at] += static_cast<double>(seen_here[w]);
                     }
                 }
             }
@@ -198,9 +226,30 @@ void visible_fraction(const Segment* segs, const uint8_t* sides, size_t n, doubl
             for (size_t j = 0; j < Ms; ++j) {
                 seen += front[w][j] + passive[w][j];
                 all += count[w][j];
+                if (group && front[w][j])
+                    gseen[static_cast<size_t>(group[front_of[w][j]]) * directional_bins + static_cast<size_t>(k + w * half)] += 1;
             }
             if (all > 0) out[k + w * half] = static_cast<double>(seen) / static_cast<double>(all);
         }
+    }
+}
+
+}  // namespace
+
+void visible_fraction(const Segment* segs, const uint8_t* sides, size_t n, double out[directional_bins], int lines) {
+    measure(segs, sides, n, out, lines, nullptr, nullptr, nullptr);
+}
+
+void visible_fraction(const Segment* segs, const uint8_t* sides, size_t n, double out[directional_bins],
+                      const int32_t* group, int groups, double* group_out, int lines) {
+    const size_t G = static_cast<size_t>(groups) * directional_bins;
+    thread_local std::vector<double> seen, all;
+    seen.assign(G, 0.0);
+    all.assign(G, 0.0);
+    measure(segs, sides, n, out, lines, group, seen.data(), all.data());
+    for (size_t q = 0; q < G; ++q) {
+        const double share = seen[q] / all[q];
+        group_out[q] = all[q] > 0 && std::isfinite(share) ? std::clamp(share, 0.0, 1.0) : 1.0;
     }
 }
 

@@ -55,4 +55,13 @@ inline constexpr size_t exact_up_to = 24;
 void visible_fraction(const Segment* segs, const uint8_t* sides, size_t n, double out[directional_bins],
                       int lines = 0);
 
+/// The same, and per group of the segments (segment i in group[i], in 0 ..
+/// groups - 1; a cluster's children): the share of each group's own lobes
+/// seen from outside the whole set, written to group_out[g * K + k] (1
+/// where none of the group's sides faces u_k). Measured on the same lines
+/// (or exactly) as `out`, so that out's share is the groups' seen lobes
+/// over all of their lobes.
+void visible_fraction(const Segment* segs, const uint8_t* sides, size_t n, double out[directional_bins],
+                      const int32_t* group, int groups, double* group_out, int lines = 0);
+
 }  // namespace flatrad

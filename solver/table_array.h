@@ -74,11 +74,15 @@ public:
     /// samples its children have them too (how the slots are chosen), and
     /// samples are summed where both have them; a parent with samples and
     /// a child without would lose light silently, so it is asserted.
-    void sum_child(int parent, int child) { add(parent, child, parent, child); }
-    void add_parent(int child, int parent) { add(child, parent, parent, child); }
+    /// With `scale` (per bin, not null), the samples added are scaled by
+    /// it (the child's share seen from outside the parent); the linear
+    /// parts are added as they are (a table below which something is
+    /// hidden is never read or written through its linear part).
+    void sum_child(int parent, int child, const double* scale = nullptr) { add(parent, child, parent, child, scale); }
+    void add_parent(int child, int parent, const double* scale = nullptr) { add(child, parent, parent, child, scale); }
 
 private:
-    void add(int dst, int src, [[maybe_unused]] int parent, [[maybe_unused]] int child) {
+    void add(int dst, int src, [[maybe_unused]] int parent, [[maybe_unused]] int child, const double* scale) {
         double* dl = linear(dst);
         const double* sl = linear(src);
         dl[0] += sl[0];
@@ -86,8 +90,12 @@ private:
         double* ds = samples(dst);
         const double* ss = samples(src);
         FLATRAD_ASSERT(slot(parent) < 0 || slot(child) >= 0, "a table with samples above one without");
-        if (ds && ss)
-            for (int k = 0; k < directional_bins; ++k) ds[k] += ss[k];
+        if (ds && ss) {
+            if (scale)
+                for (int k = 0; k < directional_bins; ++k) ds[k] += scale[k] * ss[k];
+            else
+                for (int k = 0; k < directional_bins; ++k) ds[k] += ss[k];
+        }
     }
     int32_t slot(int t) const { return m_slot ? (*m_slot)[static_cast<size_t>(t)] : t; }
     void assign(int tables, int slotted) {
