@@ -115,7 +115,8 @@
 ///    their errors add up); until then it carries tau_est, the
 ///    transmittance of blockers spread at the scene's mean density over
 ///    the gap between its nodes, exp(-kappa g) (kappa: layers of shadow
-///    per unit of depth, MultiscaleVisibility::layers_per_depth). A
+///    per unit of depth, MultiscaleVisibility::layers_per_depth), with a
+///    cluster's box counting the blockers in it that are not its members. A
 ///    sender too dim for any transmittance to matter is never queried;
 ///    later rounds ask again against the new solution.
 ///    stats.unqueried_links counts the links the final solve carried so.
