@@ -29,7 +29,7 @@ Facing facing_ways(const Segment& s, uint8_t has, Vec2 u) {
 // once: bins k and k + K/2 look along u and -u, where each pair's overlap
 // is the same and the front one along u is the back one along -u.
 void visible_fraction_exact(const Segment* segs, const uint8_t* sides, size_t n, double out[directional_bins],
-                            const int32_t* group, double* gseen, double* gall) {
+                            const int32_t* group, double* gseen, double* gall, double* dsum) {
     static_assert(directional_bins % 2 == 0, "bin k + K/2 looks along -u");
     constexpr int half = directional_bins / 2;
     struct Proj {
@@ -89,6 +89,7 @@ void visible_fraction_exact(const Segment* segs, const uint8_t* sides, size_t n,
                     const double width = a.hi - a.lo, visible = uncovered(a.lo, a.hi, hidden[w]);
                     all[w] += width;
                     seen[w] += visible;
+                    if (dsum) dsum[k + w * half] += visible * (w == 0 ? 1 : -1) * 0.5 * (a.dlo + a.dhi);
                     if (group) {
                         const size_t at = static_cast<size_t>(group[i]) * directional_bins + static_cast<size_t>(k + w * half);
                         gall[at] += width;
@@ -110,10 +111,10 @@ namespace {
 // Both visible_fraction()s: with `group`, also each group's seen and
 // facing lobes per bin (gseen, gall: groups x K, zeroed by the caller).
 void measure(const Segment* segs, const uint8_t* sides, size_t n, double out[directional_bins], int lines,
-             const int32_t* group, double* gseen, double* gall) {
+             const int32_t* group, double* gseen, double* gall, double* dsum) {
     std::fill(out, out + directional_bins, 1.0);
     if (n < 2) return;  // one segment cannot hide itself
-    if (lines == 0 && n <= exact_up_to) return visible_fraction_exact(segs, sides, n, out, group, gseen, gall);
+    if (lines == 0 && n <= exact_up_to) return visible_fraction_exact(segs, sides, n, out, group, gseen, gall, dsum);
     const int M = lines > 0 ? lines : static_cast<int>(std::clamp<size_t>(2 * n, 64, 1024));
     const size_t Ms = static_cast<size_t>(M);
     // Bins k and k + K/2 look along u and -u: the same lines across, each
@@ -187,6 +188,7 @@ void measure(const Segment* segs, const uint8_t* sides, size_t n, double out[dir
                 const double d_step = wl * slope;
                 const int32_t me = static_cast<int32_t>(i);
                 long seen_here[2] = {0, 0};
+                double depth_here[2] = {0, 0};
                 for (int j = j0; j <= j1; ++j) {
                     const size_t js = static_cast<size_t>(j);
                     const double d = d_lo + j * d_step;
@@ -209,7 +211,13 @@ void measure(const Segment* segs, const uint8_t* sides, size_t n, double out[dir
                         passive[1][js] += s1;
                         seen_here[0] += s0;
                         seen_here[1] += s1;
+                        depth_here[0] += s0 ? d : 0.0;
+                        depth_here[1] += s1 ? -d : 0.0;
                     }
+                }
+                if (dsum && pass == 1) {
+                    dsum[k] += depth_here[0];
+                    dsum[k + half] += depth_here[1];
                 }
                 if (group && j1 >= j0) {
                     const size_t g = static_cast<size_t>(group[i]) * directional_bins;
@@ -228,6 +236,7 @@ void measure(const Segment* segs, const uint8_t* sides, size_t n, double out[dir
                 all += count[w][j];
                 if (group && front[w][j])
                     gseen[static_cast<size_t>(group[front_of[w][j]]) * directional_bins + static_cast<size_t>(k + w * half)] += 1;
+                if (dsum && front[w][j]) dsum[k + w * half] += w == 0 ? depth[0][j] : -depth[1][j];
             }
             if (all > 0) out[k + w * half] = static_cast<double>(seen) / static_cast<double>(all);
         }
@@ -237,16 +246,25 @@ void measure(const Segment* segs, const uint8_t* sides, size_t n, double out[dir
 }  // namespace
 
 void visible_fraction(const Segment* segs, const uint8_t* sides, size_t n, double out[directional_bins], int lines) {
-    measure(segs, sides, n, out, lines, nullptr, nullptr, nullptr);
+    measure(segs, sides, n, out, lines, nullptr, nullptr, nullptr, nullptr);
 }
 
 void visible_fraction(const Segment* segs, const uint8_t* sides, size_t n, double out[directional_bins],
-                      const int32_t* group, int groups, double* group_out, int lines) {
+                      const int32_t* group, int groups, double* group_out, int lines, double* front) {
     const size_t G = static_cast<size_t>(groups) * directional_bins;
     thread_local std::vector<double> seen, all;
     seen.assign(G, 0.0);
     all.assign(G, 0.0);
-    measure(segs, sides, n, out, lines, group, seen.data(), all.data());
+    double dsum[directional_bins] = {};
+    measure(segs, sides, n, out, lines, group, seen.data(), all.data(), front ? dsum : nullptr);
+    if (front)
+        for (int k = 0; k < directional_bins; ++k) {
+            // The groups' seen lobes summed, per bin (also what `out` is of all).
+            double s = 0;
+            for (int q = 0; q < groups; ++q) s += seen[static_cast<size_t>(q) * directional_bins + static_cast<size_t>(k)];
+            const double mean = dsum[k] / s;
+            front[k] = s > 0 && std::isfinite(mean) ? mean : std::numeric_limits<double>::quiet_NaN();
+        }
     for (size_t q = 0; q < G; ++q) {
         const double share = seen[q] / all[q];
         group_out[q] = all[q] > 0 && std::isfinite(share) ? std::clamp(share, 0.0, 1.0) : 1.0;

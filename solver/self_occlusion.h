@@ -61,7 +61,12 @@ void visible_fraction(const Segment* segs, const uint8_t* sides, size_t n, doubl
 /// where none of the group's sides faces u_k). Measured on the same lines
 /// (or exactly) as `out`, so that out's share is the groups' seen lobes
 /// over all of their lobes.
+/// With `front` (K values, not null), also per bin k the mean depth along
+/// u_k, dot(x, u_k), of the lobes seen from far along u_k (each visible
+/// part at its side's middle on the exact path, at the line's crossing on
+/// lines): where the cluster's visible face lies. NaN where nothing is
+/// seen (n < 2 included).
 void visible_fraction(const Segment* segs, const uint8_t* sides, size_t n, double out[directional_bins],
-                      const int32_t* group, int groups, double* group_out, int lines = 0);
+                      const int32_t* group, int groups, double* group_out, int lines = 0, double* front = nullptr);
 
 }  // namespace flatrad

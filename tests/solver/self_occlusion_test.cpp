@@ -331,6 +331,28 @@ TEST_CASE("visible fraction by groups: each child's own share, and the whole sha
             CHECK(g[0 * directional_bins + right] == 1.0);  // along the sticks nothing faces: 1
         }
     }
+    SUBCASE("the visible face: the seen lobes' mean depth along each direction") {
+        // The upper stick shifted by half: from above, all of it (width 1 at
+        // depth 1) and the lower one's free half (width 0.5 at depth 0):
+        // 2/3; from below (depth along -y), all of the lower one (at 0) and
+        // the upper one's free half (at -1): -1/3.
+        const std::vector<Segment> segs{{{0, 0}, {1, 0}}, {{0.5, 1}, {1.5, 1}}};
+        const std::vector<uint8_t> sides{two_sided, two_sided};
+        const std::vector<int32_t> group{0, 0};
+        constexpr int lines = 3000;
+        // On lines each of the 4 run ends is off by a line (1.5 / 3000 wide)
+        // over a seen width of 1.5, at depths at most 1 apart.
+        const double line_tol = 4 * (1.5 / lines) / 1.5;
+        for (int l : {0, lines}) {
+            CAPTURE(l);
+            double g[directional_bins], front[directional_bins];
+            visible_fraction(segs.data(), sides.data(), segs.size(), f, group.data(), 1, g, l, front);
+            const double tol = l == 0 ? 1e-15 : line_tol;
+            CHECK(std::abs(front[up] - 2.0 / 3) <= tol);
+            CHECK(std::abs(front[down] + 1.0 / 3) <= tol);
+            CHECK(std::isnan(front[right]));  // nothing faces along the sticks
+        }
+    }
     SUBCASE("random sticks in random groups: the groups' seen lobes add up to the whole's (exact path)") {
         std::mt19937 rng(23);
         std::uniform_real_distribution<double> U(0, 1);
