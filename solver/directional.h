@@ -95,6 +95,37 @@ inline const std::array<Vec2, directional_bins>& bin_directions() {
     return dirs;
 }
 
+namespace directional_detail {
+// A factor of 1 at every bin (the unscaled lobes: x * 1.0 is x).
+struct Unscaled {
+    double operator[](int) const { return 1.0; }
+};
+template <class Scale>
+inline void add_lobe(double* samples, double* linear, Vec2 n, double w, const Scale& scale) {
+    if (samples) {
+        const auto& d = bin_directions();
+        for (int k = 0; k < directional_bins; ++k) {
+            const double c = n.x * d[static_cast<size_t>(k)].x + n.y * d[static_cast<size_t>(k)].y;
+            samples[k] += w * scale[k] * std::max(c, 0.0);
+        }
+    }
+    linear[0] += w * n.x;
+    linear[1] += w * n.y;
+}
+template <class Scale>
+inline double read_lobe(const double* samples, const double* linear, Vec2 n, const Scale& scale) {
+    double s = 0;
+    if (samples) {
+        const auto& d = bin_directions();
+        for (int k = 0; k < directional_bins; ++k) {
+            const double c = n.x * d[static_cast<size_t>(k)].x + n.y * d[static_cast<size_t>(k)].y;
+            s += scale[k] * samples[k] * std::max(c, 0.0);
+        }
+    }
+    return s + n.x * linear[0] + n.y * linear[1];
+}
+}  // namespace directional_detail
+
 /// Adds the lobe w cos+(n . u) to a table held as two arrays: to its
 /// samples (w cos+(n . u(phi_k))), unless `samples` is null (a table kept
 /// without samples, solver/table_array.h), and to its linear part (w n).
@@ -105,28 +136,12 @@ inline const std::array<Vec2, directional_bins>& bin_directions() {
 /// tests/solver/cluster_model_test.cpp; on the 1000-segment forest at eps
 /// 50, 5% fewer instructions in all, callgrind, one thread.)
 inline void add_cosine_lobe(double* samples, double* linear, Vec2 n, double w) {
-    if (samples) {
-        const auto& d = bin_directions();
-        for (int k = 0; k < directional_bins; ++k) {
-            const double c = n.x * d[static_cast<size_t>(k)].x + n.y * d[static_cast<size_t>(k)].y;
-            samples[k] += w * std::max(c, 0.0);
-        }
-    }
-    linear[0] += w * n.x;
-    linear[1] += w * n.y;
+    directional_detail::add_lobe(samples, linear, n, w, directional_detail::Unscaled{});
 }
 
 /// The same with the samples' terms scaled per bin by `scale` (not null).
 inline void add_cosine_lobe(double* samples, double* linear, Vec2 n, double w, const double* scale) {
-    if (samples) {
-        const auto& d = bin_directions();
-        for (int k = 0; k < directional_bins; ++k) {
-            const double c = n.x * d[static_cast<size_t>(k)].x + n.y * d[static_cast<size_t>(k)].y;
-            samples[k] += w * scale[k] * std::max(c, 0.0);
-        }
-    }
-    linear[0] += w * n.x;
-    linear[1] += w * n.y;
+    directional_detail::add_lobe(samples, linear, n, w, scale);
 }
 
 /// The same on a table of directional_table_width doubles.
@@ -138,28 +153,12 @@ inline void add_cosine_lobe(double* table, Vec2 n, double w) {
 /// cos+(n . u(psi_k)) from the samples (none when `samples` is null), plus
 /// n . (linear part).
 inline double read_cosine_lobe(const double* samples, const double* linear, Vec2 n) {
-    double s = 0;
-    if (samples) {
-        const auto& d = bin_directions();
-        for (int k = 0; k < directional_bins; ++k) {
-            const double c = n.x * d[static_cast<size_t>(k)].x + n.y * d[static_cast<size_t>(k)].y;
-            s += samples[k] * std::max(c, 0.0);
-        }
-    }
-    return s + n.x * linear[0] + n.y * linear[1];
+    return directional_detail::read_lobe(samples, linear, n, directional_detail::Unscaled{});
 }
 
 /// The same with the samples scaled per bin by `scale` (not null).
 inline double read_cosine_lobe(const double* samples, const double* linear, Vec2 n, const double* scale) {
-    double s = 0;
-    if (samples) {
-        const auto& d = bin_directions();
-        for (int k = 0; k < directional_bins; ++k) {
-            const double c = n.x * d[static_cast<size_t>(k)].x + n.y * d[static_cast<size_t>(k)].y;
-            s += scale[k] * samples[k] * std::max(c, 0.0);
-        }
-    }
-    return s + n.x * linear[0] + n.y * linear[1];
+    return directional_detail::read_lobe(samples, linear, n, scale);
 }
 
 /// The same on a table of directional_table_width doubles.

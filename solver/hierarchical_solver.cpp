@@ -398,10 +398,12 @@ struct Estimate {
     double value;
     float bound;
 };
-Estimate within_bound(double answer, double bound, double top, double estimate) {
+// (`estimate` is called only when the bound is not 0.)
+template <class EstimateFn>
+Estimate within_bound(double answer, double bound, double top, const EstimateFn& estimate) {
     if (!(bound > 0)) return {answer, static_cast<float>(bound)};
     const double lo = std::max(0.0, answer - bound), hi = std::min(top, answer + bound);
-    const double v = std::clamp(estimate, lo, std::max(lo, hi));
+    const double v = std::clamp(estimate(), lo, std::max(lo, hi));
     const double b = std::max(v - lo, hi - v);
     float f = static_cast<float>(b);
     if (f < b) f = std::nextafter(f, std::numeric_limits<float>::infinity());
@@ -1618,7 +1620,7 @@ bool HierarchicalSolver::resolve_visibility(Link& l, ExactWorkspace& ws, Visibil
             l.coef = 0;
             return false;
         }
-        const Estimate F = within_bound(m.F, m.error_bound, Fu, prior_transmittance(nr, ns) * Fu);
+        const Estimate F = within_bound(m.F, m.error_bound, Fu, [&] { return prior_transmittance(nr, ns) * Fu; });
         l.coef = F.value;
         l.tau = static_cast<float>(F.value / Fu);
         l.vis_err = F.bound;
@@ -1630,7 +1632,7 @@ bool HierarchicalSolver::resolve_visibility(Link& l, ExactWorkspace& ws, Visibil
         l.tau = 0;
         return false;
     }
-    const Estimate tau = within_bound(tau_answer, terr, 1.0, prior_transmittance(nr, ns));
+    const Estimate tau = within_bound(tau_answer, terr, 1.0, [&] { return prior_transmittance(nr, ns); });
     l.tau = static_cast<float>(tau.value);
     l.vis_err = tau.bound;
     l.Fu = 0;
