@@ -139,8 +139,9 @@ inline void add_cosine_lobe(double* samples, double* linear, Vec2 n, double w) {
     directional_detail::add_lobe(samples, linear, n, w, directional_detail::Unscaled{});
 }
 
-/// The same with the samples' terms scaled per bin by `scale` (not null).
-inline void add_cosine_lobe(double* samples, double* linear, Vec2 n, double w, const double* scale) {
+/// The same with the samples' terms scaled per bin by `scale` (not null;
+/// floats: the solver's per-child factors, solver/hierarchical_solver.cpp).
+inline void add_cosine_lobe(double* samples, double* linear, Vec2 n, double w, const float* scale) {
     directional_detail::add_lobe(samples, linear, n, w, scale);
 }
 
@@ -157,7 +158,7 @@ inline double read_cosine_lobe(const double* samples, const double* linear, Vec2
 }
 
 /// The same with the samples scaled per bin by `scale` (not null).
-inline double read_cosine_lobe(const double* samples, const double* linear, Vec2 n, const double* scale) {
+inline double read_cosine_lobe(const double* samples, const double* linear, Vec2 n, const float* scale) {
     return directional_detail::read_lobe(samples, linear, n, scale);
 }
 
@@ -179,7 +180,8 @@ inline void add_linear_part(double* linear, Vec2 u, double c) {
 inline double read_linear(const double* table, Vec2 u) { return read_linear_part(table + directional_bins, u); }
 inline void add_linear(double* table, Vec2 u, double c) { add_linear_part(table + directional_bins, u, c); }
 
-inline double interpolate(const double* table, BinWeight b) {
+template <class T>
+inline double interpolate(const T* table, BinWeight b) {
     return (1 - b.t) * table[b.k] + b.t * table[b.next()];
 }
 

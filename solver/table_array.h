@@ -78,11 +78,11 @@ public:
     /// it (the child's share seen from outside the parent); the linear
     /// parts are added as they are (a table below which something is
     /// hidden is never read or written through its linear part).
-    void sum_child(int parent, int child, const double* scale = nullptr) { add(parent, child, parent, child, scale); }
-    void add_parent(int child, int parent, const double* scale = nullptr) { add(child, parent, parent, child, scale); }
+    void sum_child(int parent, int child, const float* scale = nullptr) { add(parent, child, parent, child, scale); }
+    void add_parent(int child, int parent, const float* scale = nullptr) { add(child, parent, parent, child, scale); }
 
 private:
-    void add(int dst, int src, [[maybe_unused]] int parent, [[maybe_unused]] int child, const double* scale) {
+    void add(int dst, int src, [[maybe_unused]] int parent, [[maybe_unused]] int child, const float* scale) {
         double* dl = linear(dst);
         const double* sl = linear(src);
         dl[0] += sl[0];
