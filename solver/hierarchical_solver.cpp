@@ -181,21 +181,21 @@ constexpr double split_margin = 0.97;
 constexpr double deferred_share = 0.1;
 
 // Links between overlapping or touching nodes (Link::unresolved) have no
-// point approximation: they carry nothing until split. What they leave out is at most all the sender's
-// power that can reach the receiver, B_max(s) min(L(s), L(r)) with B_max
-// the highest leaf value below and L the total length of the leaves below
-// (an irradiance from s is at most B_max(s) anywhere; link_error). Such a
-// link is split only when that bound exceeds this share of the bar: the
-// light it leaves out is one-signed, a loss that adds up over links. Until
-// the twenty-fifth session it was split whenever its sender sent anything
-// at all (HierarchicalOptions::faint_overlaps_kept off), so the first
-// solve's faint light (1e-15) split every link between neighbouring
-// clusters down to their segments, all over a forest's dark part. With it, the 10^4 forest at eps 10 keeps 60 785 links instead
-// of 112 389 (share 0.1: 43 031, 0.01: 51 081), the same relative L2
-// against eps 0.5 (7.08e-3) and balance (6.83e-3 against 6.78e-3; share
-// 0.1: 9.2e-3, 0.01: 7.2e-3); the 1000-segment forest at eps 10 11 152
-// links instead of 12 476, balance 3.4e-3 against 3.2e-3 (share 0.1:
-// 6 049 and 1.6e-2).
+// point approximation: they carry nothing until split. What they leave out
+// is at most all the sender's power that can reach the receiver, B_max(s)
+// min(L(s), L(r)) with B_max the highest leaf value below and L the total
+// length of the leaves below (an irradiance from s is at most B_max(s)
+// anywhere; link_error). Such a link is split only when that bound exceeds
+// this share of the bar: the light it leaves out is one-signed, a loss that
+// adds up over links. Until the twenty-fifth session it was split whenever
+// its sender sent anything at all (HierarchicalOptions::faint_overlaps_kept
+// off), so the first solve's faint light (1e-15) split every link between
+// neighbouring clusters down to their segments, all over a forest's dark
+// part. With it, the 10^4 forest at eps 10 keeps 60 785 links instead of
+// 112 389 (share 0.1: 43 031, 0.01: 51 081), the same relative L2 against
+// eps 0.5 (7.08e-3) and balance (6.83e-3 against 6.78e-3; share 0.1: 9.2e-3,
+// 0.01: 7.2e-3); the 1000-segment forest at eps 10 11 152 links instead of
+// 12 476, balance 3.4e-3 against 3.2e-3 (share 0.1: 6 049 and 1.6e-2).
 constexpr double unresolved_share = 1e-3;
 
 // The first refinement is against the emission alone (run) where the scene

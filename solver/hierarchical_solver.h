@@ -87,8 +87,9 @@
 ///    (unresolved_share in the .cpp: a one-signed loss): a forest's dark
 ///    part, lit at 1e-15 by the first solve, is no longer split down to its
 ///    segments (the 10^4 forest at eps 10: 60 785 links instead of 112 389,
-///    the same error and balance). Except chain links: two arcs of one convex loop lit on the room's side
-///    (neighbours along a curved wall) whose hull no segment meets (in
+///    the same error and balance). Except chain links: two arcs of one
+///    convex loop lit on the room's side (neighbours along a curved wall)
+///    whose hull no segment meets (in
 ///    rooms holding at most 64 segments that may block) exchange their
 ///    exact etendue (crossed strings on their chords; an arc with itself:
 ///    its length minus its chord), the sender's mean spread evenly on the
