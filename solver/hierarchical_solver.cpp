@@ -2003,6 +2003,17 @@ LinkError HierarchicalSolver::link_error(const Link& l, const std::vector<double
         }
         return {err, size_r >= size_s};
     }
+    if (l.unresolved) {
+        // Overlapping nodes (a cluster at one end at least): no point
+        // approximation holds; the link carries nothing, and is split (the
+        // larger side) when what it may leave out is above its share of the
+        // bar (see unresolved_share). Nothing below is read for it.
+        const double lost = m_Bmax[static_cast<size_t>(l.s)] *
+                            std::min(m_Lsum[static_cast<size_t>(l.s)], m_Lsum[static_cast<size_t>(l.r)]);
+        if (!(lost > 0)) return {};
+        return {m_opt.faint_overlaps_kept ? lost / unresolved_share : std::numeric_limits<double>::infinity(),
+                size_r >= size_s};
+    }
     // Cluster links: the power carried, unoccluded, and its uncertainty.
     // A linear read (every member faces u) is exact at the centres'
     // direction u. Where members may turn away over the spread below, the
@@ -2035,16 +2046,6 @@ LinkError HierarchicalSolver::link_error(const Link& l, const std::vector<double
         }
     } else {
         v = Bn[static_cast<size_t>(l.s)];
-    }
-    if (l.unresolved) {
-        // Overlapping nodes: no point approximation holds; the link carries
-        // nothing, and is split (the larger side) when what it may leave out
-        // is above its share of the bar (see unresolved_share).
-        const double lost = m_Bmax[static_cast<size_t>(l.s)] *
-                            std::min(m_Lsum[static_cast<size_t>(l.s)], m_Lsum[static_cast<size_t>(l.r)]);
-        if (!(lost > 0)) return {};
-        return {m_opt.faint_overlaps_kept ? lost / unresolved_share : std::numeric_limits<double>::infinity(),
-                size_r >= size_s};
     }
     const double dist = norm(r.center - s.center);
     // The point approximation reads each table at one direction; over the
