@@ -143,6 +143,22 @@ constexpr int closure_screen_bins = 192;
 constexpr std::array<double, 4> closure_screen_depths = {1.05, 0.7, 0.47, 0.37};
 constexpr double closure_screen_spread = 0.04;
 
+// Whole-box closure (visibility/box_closure.h, shown_closed_whole): a
+// pending link with a cluster at one end at least, about to be split on its
+// geometry, whose density's estimate of the transmittance is at most
+// box_proof_below, is first tried with one proof that every line between
+// its ends is blocked; shown so, it is dropped whole, exactly, instead of
+// being split into pieces that are each asked (and found closed). A proof
+// that leaves a gap is wasted (the link is split as before), and its
+// shafts' slabs cost about a query each. The 10^6 forest at eps 10 (one
+// run each): 6.76 M queries without, 2.25 M with the bar at 1e-6 (217 601
+// links dropped whole), 2.30 M at 1e-10 (204 120), the same solution
+// within 5e-7 relative L2. The 10^4 forest at eps 10 (one thread,
+// callgrind): 10.32 G instructions without, 10.79 / 10.39 / 10.31 G at
+// 1e-6 / 1e-10 / 1e-15 (736 / 295 / 6 links dropped whole): there the
+// proofs mostly replace closure screens' answers, which cost less.
+constexpr double box_proof_below = 1e-10;
+
 // GMRES stops at ||E - (I - rho G) B|| <= 1e-12 ||E||: the operator is
 // applied in double with sums of at most a few thousand terms per node, so
 // 1e-12 is reachable and keeps B to ~1e-9 relative even where
@@ -616,6 +632,7 @@ private:
     double kernel_variation(const Node& r, const Node& s, double Fu) const;
     std::pair<double, double> link_transmittance(int r, int s, ExactWorkspace& ws, VisibilityStats& st) const;
     bool behind_closure_screen(int e, const Box& region, ExactWorkspace& ws, VisibilityStats& st) const;
+    bool shown_closed_whole(const Link& l, ExactWorkspace& ws, VisibilityStats& st) const;
     Box cluster_target_region(int hnode, Vec2 from) const;
     void compute_links(LinkVector& links);
     int split_element(int node);
@@ -1810,6 +1827,23 @@ bool HierarchicalSolver::behind_closure_screen(int e, const Box& region, ExactWo
     return false;
 }
 
+// Whether every line between a link's two ends is shown blocked at once
+// (visibility/box_closure.h): from an element's lit side, or from anywhere
+// in a cluster's box, to anywhere in the other end's cluster box, the
+// segments of either end's skipped node not counted (link_transmittance's
+// skips). Element pairs are left to their own query.
+bool HierarchicalSolver::shown_closed_whole(const Link& l, ExactWorkspace& ws, VisibilityStats& st) const {
+    const Node& nr = m_nodes[static_cast<size_t>(l.r)];
+    const Node& ns = m_nodes[static_cast<size_t>(l.s)];
+    const auto skip = [&](int h) { return m_tau_skip[static_cast<size_t>(h)]; };
+    if (nr.cluster() && ns.cluster())
+        return m_vis.boxes_shown_closed(ns.hnode, skip(ns.hnode), nr.hnode, skip(nr.hnode), ws, st);
+    if (!nr.cluster() && !ns.cluster()) return false;
+    const Node& e = nr.cluster() ? ns : nr;
+    const Node& c = nr.cluster() ? nr : ns;
+    return m_vis.box_shown_closed(e.seg, skip(e.hnode), c.hnode, skip(c.hnode), ws, st);
+}
+
 void HierarchicalSolver::compute_links(LinkVector& links) {
     const auto t0 = Clock::now();
     const long n = static_cast<long>(links.size());
@@ -2289,6 +2323,12 @@ bool HierarchicalSolver::refine(const std::vector<double>& leaf_bmax, double exi
                     if (can_r || can_s) {
                         const LinkError g = error(true);
                         if (g.err > eps_abs) {
+                            if (m_opt.box_closure && l.tau <= box_proof_below && (r.cluster() || s.cluster()) &&
+                                shown_closed_whole(l, ws, local)) {
+                                ++local.boxed;
+                                decision[static_cast<size_t>(k)] = 4;  // closed whole: dropped
+                                continue;
+                            }
                             decision[static_cast<size_t>(k)] = can_r && (!can_s || g.split_r) ? 1 : 2;
                             above = true;
                             continue;

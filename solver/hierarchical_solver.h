@@ -138,6 +138,16 @@
 ///    per element and bin, so the answer depends only on the link, not on
 ///    which thread asked first. stats.visibility.screens counts the screens
 ///    shown closed, .screened the links they answered.
+///  - Whole-box closure (visibility/box_closure.h): a pending link with a
+///    cluster at one end whose geometry alone asks for a split, and whose
+///    density's estimate of the transmittance is tiny, is first tried with
+///    one proof that every line between its ends' boxes is blocked (one
+///    slab proof per pair of facing box sides, the ends' own segments left
+///    out); shown so, the link is dropped whole, exactly, where its pieces
+///    would each have been split and asked. A lamp's links to a forest
+///    hundreds of layers deep were split on their geometry down to clusters
+///    of a few sticks, each then shown closed on its own.
+///    stats.visibility.boxed counts the links dropped so.
 ///  - Solve: per channel, the matrix-free operator on the element leaves:
 ///    pull (means up the element trees, exitance tables up the clusters),
 ///    gather along the links (in parallel over receivers), push (tables
@@ -211,6 +221,12 @@ struct HierarchicalOptions {
     /// it (see "Closure screens" above); off: every such link asks its own
     /// query (for tests: the oracle).
     bool closure_screens = true;
+    /// Whole-box closure (visibility/box_closure.h): a link with a cluster
+    /// at one end, nearly surely closed by the density's estimate, is tried
+    /// with one proof that every line between its ends is blocked before it
+    /// is split on its geometry, and dropped whole when shown so; off: split
+    /// and its pieces asked one by one (for tests: the oracle).
+    bool box_closure = true;
     /// Solves between refinement rounds stop at a looser residual (see
     /// "Solve" above); off: every solve to the full 1e-12 (for tests: the
     /// same links whichever way the operator is split into parts, as the

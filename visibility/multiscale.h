@@ -194,6 +194,21 @@ public:
     bool shown_closed(const Segment& a, int skip_a, const Segment& t, ExactWorkspace& ws,
                       VisibilityStats& stats) const;
 
+    /// Whether every line from segment a (lit on its left) to any point of
+    /// hierarchy node node_b's box is shown blocked by the hierarchy's
+    /// blockers other than those of skip_a and skip_b (skip_b: node_b or an
+    /// ancestor): one slab proof (as shown_closed's) per side of the box
+    /// that faces a (box_closure.h, which says why that suffices). False
+    /// when a meets the box, when the proofs are off (as shown_closed), or
+    /// when any side's proof leaves a gap. Counted in stats.queries and
+    /// stats.slabs per closed side, as any such proof.
+    bool box_shown_closed(const Segment& a, int skip_a, int node_b, int skip_b, ExactWorkspace& ws,
+                          VisibilityStats& stats) const;
+    /// The same from any point of node_a's box (disjoint from node_b's):
+    /// one proof per pair of sides that face each other.
+    bool boxes_shown_closed(int node_a, int skip_a, int node_b, int skip_b, ExactWorkspace& ws,
+                            VisibilityStats& stats) const;
+
 private:
     std::optional<TransmittanceResult> transmittance_between(const Segment& sa, const Segment& sb, int skip_a,
                                                              int skip_b, double eps, GammaRule rule,
@@ -207,6 +222,11 @@ private:
     MultiscaleResult form_factor_skipping(const Segment& i, const Segment& j, SkipRange skip_a, SkipRange skip_b,
                                           double eps, GammaRule rule, ExactWorkspace& ws, VisibilityStats& stats,
                                           bool slabs_only = false) const;
+
+    /// box_closure.cpp: every line from one of `from` to the box `to` shown
+    /// closed, side by side.
+    bool sides_shown_closed(const Segment* from, int n_from, SkipRange skip_from, const Box& to, SkipRange skip_to,
+                            ExactWorkspace& ws, VisibilityStats& stats) const;
 
     const Hierarchy* m_hierarchy;
     const ClusterTables* m_tables;

@@ -161,6 +161,7 @@ ordered_json visibility_stats_json(const VisibilityStats& s) {
     j["slabs"] = s.slabs;
     j["screens"] = s.screens;
     j["screened"] = s.screened;
+    j["boxed"] = s.boxed;
     return j;
 }
 

@@ -1,0 +1,83 @@
+#include "visibility/box_closure.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "engine/formfactor.h"
+#include "visibility/multiscale.h"
+
+namespace flatrad {
+
+std::array<Segment, 4> outward_sides(const Box& b, double margin) {
+    const Vec2 lo{b.lo.x - margin, b.lo.y - margin}, hi{b.hi.x + margin, b.hi.y + margin};
+    // Corners counter-clockwise; a side walked clockwise has the outside on
+    // its left (rot90 turns counter-clockwise).
+    const Vec2 c[4] = {lo, {hi.x, lo.y}, hi, {lo.x, hi.y}};
+    return {Segment{c[1], c[0]}, Segment{c[2], c[1]}, Segment{c[3], c[2]}, Segment{c[0], c[3]}};
+}
+
+double box_margin(const Box& b) {
+    const double scale = std::max({std::abs(b.lo.x), std::abs(b.lo.y), std::abs(b.hi.x), std::abs(b.hi.y)});
+    return 64 * std::numeric_limits<double>::epsilon() * scale + 1e-9 * b.diagonal();
+}
+
+namespace {
+
+Box widened(const Box& b) {
+    const double m = box_margin(b);
+    Box w = b;
+    w.lo = {b.lo.x - m, b.lo.y - m};
+    w.hi = {b.hi.x + m, b.hi.y + m};
+    return w;
+}
+
+bool boxes_meet(const Box& a, const Box& b) {
+    return a.lo.x <= b.hi.x && b.lo.x <= a.hi.x && a.lo.y <= b.hi.y && b.lo.y <= a.hi.y;
+}
+
+}  // namespace
+
+// Every pair of a sender piece and a side of B that faces it must be shown
+// closed (box_closure.h); a pair with no line from lit side to lit side
+// has nothing to block.
+bool MultiscaleVisibility::sides_shown_closed(const Segment* from, int n_from, SkipRange skip_from, const Box& to,
+                                              SkipRange skip_to, ExactWorkspace& ws, VisibilityStats& stats) const {
+    const std::array<Segment, 4> sides = outward_sides(to, box_margin(to));
+    bool any = false;
+    for (int i = 0; i < n_from; ++i)
+        for (const Segment& t : sides) {
+            if (!clip_to_lit_halfplanes(from[i], t)) continue;
+            any = true;
+            const MultiscaleResult r =
+                form_factor_skipping(from[i], t, skip_from, skip_to, 0, GammaRule::Bound, ws, stats, true);
+            if (!(r.F == 0 && r.error_bound == 0)) return false;
+        }
+    return any;
+}
+
+bool MultiscaleVisibility::box_shown_closed(const Segment& a, int skip_a, int node_b, int skip_b, ExactWorkspace& ws,
+                                            VisibilityStats& stats) const {
+    if (!(m_layers_per_depth > 0) || m_min_pieces_to_prove_closed == std::numeric_limits<size_t>::max()) return false;
+    const ClusterNode& B = m_hierarchy->node(node_b);
+    if (B.box.empty() || segment_meets_box(a.a, a.b, widened(B.box))) return false;
+    const ClusterNode& SA = m_hierarchy->node(skip_a);
+    const ClusterNode& SB = m_hierarchy->node(skip_b);
+    return sides_shown_closed(&a, 1, SkipRange{SA.first, SA.count}, B.box, SkipRange{SB.first, SB.count}, ws,
+                              stats);
+}
+
+bool MultiscaleVisibility::boxes_shown_closed(int node_a, int skip_a, int node_b, int skip_b, ExactWorkspace& ws,
+                                              VisibilityStats& stats) const {
+    if (!(m_layers_per_depth > 0) || m_min_pieces_to_prove_closed == std::numeric_limits<size_t>::max()) return false;
+    const ClusterNode& A = m_hierarchy->node(node_a);
+    const ClusterNode& B = m_hierarchy->node(node_b);
+    if (A.box.empty() || B.box.empty() || boxes_meet(widened(A.box), widened(B.box))) return false;
+    const std::array<Segment, 4> from = outward_sides(A.box, box_margin(A.box));
+    const ClusterNode& SA = m_hierarchy->node(skip_a);
+    const ClusterNode& SB = m_hierarchy->node(skip_b);
+    return sides_shown_closed(from.data(), 4, SkipRange{SA.first, SA.count}, B.box, SkipRange{SB.first, SB.count},
+                              ws, stats);
+}
+
+}  // namespace flatrad
