@@ -199,9 +199,10 @@ public:
     /// blockers other than those of skip_a and skip_b (skip_b: node_b or an
     /// ancestor): one slab proof (as shown_closed's) per side of the box
     /// that faces a (box_closure.h, which says why that suffices). False
-    /// when a meets the box, when the proofs are off (as shown_closed), or
-    /// when any side's proof leaves a gap. Counted in stats.queries and
-    /// stats.slabs per closed side, as any such proof.
+    /// when a meets the box, when a faces none of its sides, when the
+    /// proofs are off (as shown_closed), or when any side's proof leaves a
+    /// gap. Counted in stats.queries and stats.slabs per side shown
+    /// closed, as any such proof.
     bool box_shown_closed(const Segment& a, int skip_a, int node_b, int skip_b, ExactWorkspace& ws,
                           VisibilityStats& stats) const;
     /// The same from any point of node_a's box (disjoint from node_b's):
