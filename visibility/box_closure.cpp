@@ -9,28 +9,27 @@
 
 namespace flatrad {
 
-std::array<Segment, 4> outward_sides(const Box& b, double margin) {
-    const Vec2 lo{b.lo.x - margin, b.lo.y - margin}, hi{b.hi.x + margin, b.hi.y + margin};
-    // Corners counter-clockwise; a side walked clockwise has the outside on
-    // its left (rot90 turns counter-clockwise).
-    const Vec2 c[4] = {lo, {hi.x, lo.y}, hi, {lo.x, hi.y}};
-    return {Segment{c[1], c[0]}, Segment{c[2], c[1]}, Segment{c[3], c[2]}, Segment{c[0], c[3]}};
-}
-
 double box_margin(const Box& b) {
     const double scale = std::max({std::abs(b.lo.x), std::abs(b.lo.y), std::abs(b.hi.x), std::abs(b.hi.y)});
     return 64 * std::numeric_limits<double>::epsilon() * scale + 1e-9 * b.diagonal();
 }
 
-namespace {
-
-Box widened(const Box& b) {
+Box widened_box(const Box& b) {
     const double m = box_margin(b);
     Box w = b;
     w.lo = {b.lo.x - m, b.lo.y - m};
     w.hi = {b.hi.x + m, b.hi.y + m};
     return w;
 }
+
+std::array<Segment, 4> outward_sides(const Box& b) {
+    // Corners counter-clockwise; a side walked clockwise has the outside on
+    // its left (rot90 turns counter-clockwise).
+    const Vec2 c[4] = {b.lo, {b.hi.x, b.lo.y}, b.hi, {b.lo.x, b.hi.y}};
+    return {Segment{c[1], c[0]}, Segment{c[2], c[1]}, Segment{c[3], c[2]}, Segment{c[0], c[3]}};
+}
+
+namespace {
 
 bool boxes_meet(const Box& a, const Box& b) {
     return a.lo.x <= b.hi.x && b.lo.x <= a.hi.x && a.lo.y <= b.hi.y && b.lo.y <= a.hi.y;
@@ -43,7 +42,7 @@ bool boxes_meet(const Box& a, const Box& b) {
 // has nothing to block.
 bool MultiscaleVisibility::sides_shown_closed(const Segment* from, int n_from, SkipRange skip_from, const Box& to,
                                               SkipRange skip_to, ExactWorkspace& ws, VisibilityStats& stats) const {
-    const std::array<Segment, 4> sides = outward_sides(to, box_margin(to));
+    const std::array<Segment, 4> sides = outward_sides(to);  // (to: widened already)
     bool any = false;
     for (int i = 0; i < n_from; ++i)
         for (const Segment& t : sides) {
@@ -60,11 +59,12 @@ bool MultiscaleVisibility::box_shown_closed(const Segment& a, int skip_a, int no
                                             VisibilityStats& stats) const {
     if (!(m_layers_per_depth > 0) || m_min_pieces_to_prove_closed == std::numeric_limits<size_t>::max()) return false;
     const ClusterNode& B = m_hierarchy->node(node_b);
-    if (B.box.empty() || segment_meets_box(a.a, a.b, widened(B.box))) return false;
+    if (B.box.empty()) return false;
+    const Box to = widened_box(B.box);
+    if (segment_meets_box(a.a, a.b, to)) return false;
     const ClusterNode& SA = m_hierarchy->node(skip_a);
     const ClusterNode& SB = m_hierarchy->node(skip_b);
-    return sides_shown_closed(&a, 1, SkipRange{SA.first, SA.count}, B.box, SkipRange{SB.first, SB.count}, ws,
-                              stats);
+    return sides_shown_closed(&a, 1, SkipRange{SA.first, SA.count}, to, SkipRange{SB.first, SB.count}, ws, stats);
 }
 
 bool MultiscaleVisibility::boxes_shown_closed(int node_a, int skip_a, int node_b, int skip_b, ExactWorkspace& ws,
@@ -72,12 +72,14 @@ bool MultiscaleVisibility::boxes_shown_closed(int node_a, int skip_a, int node_b
     if (!(m_layers_per_depth > 0) || m_min_pieces_to_prove_closed == std::numeric_limits<size_t>::max()) return false;
     const ClusterNode& A = m_hierarchy->node(node_a);
     const ClusterNode& B = m_hierarchy->node(node_b);
-    if (A.box.empty() || B.box.empty() || boxes_meet(widened(A.box), widened(B.box))) return false;
-    const std::array<Segment, 4> from = outward_sides(A.box, box_margin(A.box));
+    if (A.box.empty() || B.box.empty()) return false;
+    const Box from_box = widened_box(A.box), to = widened_box(B.box);
+    if (boxes_meet(from_box, to)) return false;
+    const std::array<Segment, 4> from = outward_sides(from_box);
     const ClusterNode& SA = m_hierarchy->node(skip_a);
     const ClusterNode& SB = m_hierarchy->node(skip_b);
-    return sides_shown_closed(from.data(), 4, SkipRange{SA.first, SA.count}, B.box, SkipRange{SB.first, SB.count},
-                              ws, stats);
+    return sides_shown_closed(from.data(), 4, SkipRange{SA.first, SA.count}, to, SkipRange{SB.first, SB.count}, ws,
+                              stats);
 }
 
 }  // namespace flatrad

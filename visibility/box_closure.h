@@ -37,13 +37,16 @@
 
 namespace flatrad {
 
-/// The four sides of `b` moved out by `margin`, each oriented with its lit
-/// (left) side facing out of the box.
-std::array<Segment, 4> outward_sides(const Box& b, double margin);
-
 /// The margin the proofs widen a box by: 64 ulps of its largest coordinate
 /// and 1e-9 of its diagonal, so that a segment on its side (rounded) lies
 /// strictly inside.
 double box_margin(const Box& b);
+
+/// `b` widened by box_margin(b) on every side.
+Box widened_box(const Box& b);
+
+/// The four sides of `b`, each oriented with its lit (left) side facing out
+/// of the box.
+std::array<Segment, 4> outward_sides(const Box& b);
 
 }  // namespace flatrad

@@ -224,8 +224,8 @@ private:
                                           double eps, GammaRule rule, ExactWorkspace& ws, VisibilityStats& stats,
                                           bool slabs_only = false) const;
 
-    /// box_closure.cpp: every line from one of `from` to the box `to` shown
-    /// closed, side by side.
+    /// box_closure.cpp: every line from one of `from` to the box `to`
+    /// (widened already) shown closed, side by side.
     bool sides_shown_closed(const Segment* from, int n_from, SkipRange skip_from, const Box& to, SkipRange skip_to,
                             ExactWorkspace& ws, VisibilityStats& stats) const;
 

@@ -100,7 +100,10 @@ TEST_CASE("box closure: the sides lie outside the box, each lit outward; the mar
     const double m = box_margin(b);
     CHECK(m > 0);
     CHECK(m < 1e-8 * b.diagonal() + 1e-13);
-    const auto sides = outward_sides(b, m);
+    const Box w = widened_box(b);
+    CHECK(w.lo.x == b.lo.x - m);
+    CHECK(w.hi.y == b.hi.y + m);
+    const auto sides = outward_sides(w);
     const Vec2 c = b.center();
     for (const Segment& s : sides) {
         const Vec2 n = s.left_normal();
