@@ -121,20 +121,22 @@ void measure(const Segment* segs, const uint8_t* sides, size_t n, double out[dir
     // segment meeting the same ones at the same depths, the frontmost
     // blocker along -u being the hindmost along u. Both are measured in one
     // pass over the segments, w = 0 along u, w = 1 along -u.
-    // Per line and way: the frontmost blocker's depth and whether its side
-    // facing that way exists; how many existing sides facing that way the
-    // line meets; how many of those belong to segments that cannot block
-    // and lie in front.
+    // Per line and way: the frontmost blocker's depth and which segment it
+    // is (-1: none). What a line sees is summed per segment instead, as it
+    // is found: the existing sides facing each way that a segment's lines
+    // meet (all), and a segment that cannot block where it lies in front
+    // of the frontmost blocker (seen). Only the frontmost blocker of a
+    // line is known at the end, so its share is summed over the lines
+    // then. (Per-line counts gave the same integer sums for twice the
+    // stores in the loop over lines, the hot spot of a forest's build.)
     constexpr int half = directional_bins / 2;
     thread_local std::vector<double> depth[2];
-    thread_local std::vector<uint8_t> front[2];
-    thread_local std::vector<int32_t> count[2], passive[2], front_of[2];
+    thread_local std::vector<int32_t> front_of[2];
+    thread_local std::vector<uint8_t> faces[2];  // per segment: its side facing that way exists
     for (int w = 0; w < 2; ++w) {
         front_of[w].resize(Ms);
         depth[w].resize(Ms);
-        front[w].resize(Ms);
-        count[w].resize(Ms);
-        passive[w].resize(Ms);
+        faces[w].resize(n);
     }
     const auto& dirs = bin_directions();
     constexpr double inf = std::numeric_limits<double>::infinity();
@@ -154,11 +156,8 @@ void measure(const Segment* segs, const uint8_t* sides, size_t n, double out[dir
         // Depths along u; along -u the frontmost is the least of them.
         std::fill(depth[0].begin(), depth[0].end(), -inf);
         std::fill(depth[1].begin(), depth[1].end(), inf);
-        for (int w = 0; w < 2; ++w) {
-            std::fill(front[w].begin(), front[w].end(), uint8_t{0});
-            std::fill(count[w].begin(), count[w].end(), 0);
-            std::fill(passive[w].begin(), passive[w].end(), 0);
-        }
+        for (int w = 0; w < 2; ++w) std::fill(front_of[w].begin(), front_of[w].end(), -1);
+        long seen[2] = {0, 0}, all[2] = {0, 0};
         // Blockers first (the depth buffers), then the segments that cannot
         // block: seen where in front of the frontmost blocker.
         for (int pass = 0; pass < 2; ++pass) {
@@ -171,6 +170,8 @@ void measure(const Segment* segs, const uint8_t* sides, size_t n, double out[dir
                 // rounding).
                 const Facing f = facing_ways(s, sides[i], u);
                 const bool* facing = f.way;
+                faces[0][i] = facing[0];
+                faces[1][i] = facing[1];
                 if (!blocker && !facing[0] && !facing[1]) continue;
                 double pa = dot(s.a, v), pb = dot(s.b, v), da = dot(s.a, u), db = dot(s.b, u);
                 if (pa > pb) {
@@ -180,6 +181,7 @@ void measure(const Segment* segs, const uint8_t* sides, size_t n, double out[dir
                 // Lines j, at lo + (j + 1/2) wl, within [pa, pb].
                 const int j0 = std::max(0, static_cast<int>(std::ceil((pa - lo) / wl - 0.5)));
                 const int j1 = std::min(M - 1, static_cast<int>(std::floor((pb - lo) / wl - 0.5)));
+                if (j1 < j0) continue;
                 // The depth at line j: linear in j (a segment across no
                 // width, at most one line: its middle).
                 const double span = pb - pa;
@@ -187,58 +189,65 @@ void measure(const Segment* segs, const uint8_t* sides, size_t n, double out[dir
                 const double d_lo = span > 0 ? da + (lo + 0.5 * wl - pa) * slope : 0.5 * (da + db);
                 const double d_step = wl * slope;
                 const int32_t me = static_cast<int32_t>(i);
+                const long met = j1 - j0 + 1;
+                all[0] += facing[0] ? met : 0;
+                all[1] += facing[1] ? met : 0;
                 long seen_here[2] = {0, 0};
                 double depth_here[2] = {0, 0};
-                for (int j = j0; j <= j1; ++j) {
-                    const size_t js = static_cast<size_t>(j);
-                    const double d = d_lo + j * d_step;
-                    count[0][js] += facing[0];
-                    count[1][js] += facing[1];
-                    if (pass == 0) {
-                        if (d > depth[0][js]) {
-                            depth[0][js] = d;
-                            front[0][js] = facing[0];
-                            front_of[0][js] = me;
+                if (pass == 0) {
+                    double* d0 = depth[0].data();
+                    double* d1 = depth[1].data();
+                    int32_t* f0 = front_of[0].data();
+                    int32_t* f1 = front_of[1].data();
+                    for (int j = j0; j <= j1; ++j) {
+                        const double d = d_lo + j * d_step;
+                        if (d > d0[j]) {
+                            d0[j] = d;
+                            f0[j] = me;
                         }
-                        if (d < depth[1][js]) {
-                            depth[1][js] = d;
-                            front[1][js] = facing[1];
-                            front_of[1][js] = me;
+                        if (d < d1[j]) {
+                            d1[j] = d;
+                            f1[j] = me;
                         }
-                    } else {
+                    }
+                } else {
+                    for (int j = j0; j <= j1; ++j) {
+                        const size_t js = static_cast<size_t>(j);
+                        const double d = d_lo + j * d_step;
                         const bool s0 = facing[0] && d >= depth[0][js], s1 = facing[1] && d <= depth[1][js];
-                        passive[0][js] += s0;
-                        passive[1][js] += s1;
                         seen_here[0] += s0;
                         seen_here[1] += s1;
                         depth_here[0] += s0 ? d : 0.0;
                         depth_here[1] += s1 ? -d : 0.0;
                     }
+                    seen[0] += seen_here[0];
+                    seen[1] += seen_here[1];
                 }
                 if (dsum && pass == 1) {
                     dsum[k] += depth_here[0];
                     dsum[k + half] += depth_here[1];
                 }
-                if (group && j1 >= j0) {
+                if (group) {
                     const size_t g = static_cast<size_t>(group[i]) * directional_bins;
                     for (int w = 0; w < 2; ++w) {
                         const size_t at = g + static_cast<size_t>(k + w * half);
-                        gall[at] += facing[w] ? j1 - j0 + 1 : 0;
+                        gall[at] += facing[w] ? met : 0;
                         gseen[at] += static_cast<double>(seen_here[w]);
                     }
                 }
             }
         }
         for (int w = 0; w < 2; ++w) {
-            long seen = 0, all = 0;
+            const int32_t* of = front_of[w].data();
+            const uint8_t* fw = faces[w].data();
             for (size_t j = 0; j < Ms; ++j) {
-                seen += front[w][j] + passive[w][j];
-                all += count[w][j];
-                if (group && front[w][j])
-                    gseen[static_cast<size_t>(group[front_of[w][j]]) * directional_bins + static_cast<size_t>(k + w * half)] += 1;
-                if (dsum && front[w][j]) dsum[k + w * half] += w == 0 ? depth[0][j] : -depth[1][j];
+                const int32_t i = of[j];
+                if (i < 0 || !fw[i]) continue;
+                ++seen[w];
+                if (group) gseen[static_cast<size_t>(group[i]) * directional_bins + static_cast<size_t>(k + w * half)] += 1;
+                if (dsum) dsum[k + w * half] += w == 0 ? depth[0][j] : -depth[1][j];
             }
-            if (all > 0) out[k + w * half] = static_cast<double>(seen) / static_cast<double>(all);
+            if (all[w] > 0) out[k + w * half] = static_cast<double>(seen[w]) / static_cast<double>(all[w]);
         }
     }
 }
