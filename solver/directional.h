@@ -29,7 +29,9 @@
 /// difference (tests/solver/cluster_model_test.cpp measures how often).
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <numbers>
 
 #include "engine/geometry.h"
@@ -124,7 +126,42 @@ inline double read_lobe(const double* samples, const double* linear, Vec2 n, con
     }
     return s + n.x * linear[0] + n.y * linear[1];
 }
+// read_lobe over the bins of `mask` alone (lobe_bins: where the cosine
+// is positive), in ascending order: the terms left out are the zeros the
+// others add, so the sum is the same bit for bit. (Not for add_lobe: its
+// loop over every bin has no chain of sums and vectorises; masked, the
+// 1000-segment forest's pulls took twice the instructions.)
+template <class Scale>
+inline double read_lobe_masked(const double* samples, const double* linear, Vec2 n, const Scale& scale, uint32_t mask) {
+    double s = 0;
+    if (samples) {
+        const auto& d = bin_directions();
+        for (uint32_t m = mask; m; m &= m - 1) {
+            const int k = std::countr_zero(m);
+            const double c = n.x * d[static_cast<size_t>(k)].x + n.y * d[static_cast<size_t>(k)].y;
+            s += scale[k] * samples[k] * std::max(c, 0.0);
+        }
+    }
+    return s + n.x * linear[0] + n.y * linear[1];
+}
 }  // namespace directional_detail
+
+static_assert(directional_bins <= 32, "a lobe's bins fit a 32-bit mask");
+
+/// The bins where the cosine lobe of unit normal n is positive: bit k set
+/// where n . u(phi_k) > 0, computed as add_cosine_lobe and read_cosine_lobe
+/// compute it. The masked read_cosine_lobe visits only these (about half
+/// the table): the solver's operator reads every side's lobe once per
+/// application, a chain of sums that does not vectorise.
+inline uint32_t lobe_bins(Vec2 n) {
+    const auto& d = bin_directions();
+    uint32_t mask = 0;
+    for (int k = 0; k < directional_bins; ++k) {
+        const double c = n.x * d[static_cast<size_t>(k)].x + n.y * d[static_cast<size_t>(k)].y;
+        if (std::max(c, 0.0) > 0) mask |= uint32_t{1} << k;
+    }
+    return mask;
+}
 
 /// Adds the lobe w cos+(n . u) to a table held as two arrays: to its
 /// samples (w cos+(n . u(phi_k))), unless `samples` is null (a table kept
@@ -162,6 +199,14 @@ inline double read_cosine_lobe(const double* samples, const double* linear, Vec2
     return directional_detail::read_lobe(samples, linear, n, scale);
 }
 
+/// read_cosine_lobe over the bins of mask = lobe_bins(n) alone: the same
+/// sum, bit for bit, for finite samples.
+inline double read_cosine_lobe(const double* samples, const double* linear, Vec2 n, uint32_t mask) {
+    return directional_detail::read_lobe_masked(samples, linear, n, directional_detail::Unscaled{}, mask);
+}
+inline double read_cosine_lobe(const double* samples, const double* linear, Vec2 n, const float* scale, uint32_t mask) {
+    return directional_detail::read_lobe_masked(samples, linear, n, scale, mask);
+}
 /// The same on a table of directional_table_width doubles.
 inline double read_cosine_lobe(const double* table, Vec2 n) {
     return read_cosine_lobe(table, table + directional_bins, n);

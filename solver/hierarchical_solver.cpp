@@ -295,6 +295,7 @@ struct OpNode {
     bool leaf_cluster = false;
     bool side = false;      // an element or sink right under a leaf cluster
     bool chain = false;     // Node::chain (a chain cluster's length is its elements')
+    uint32_t lobe = 0;      // elements and sinks: lobe_bins(normal), the bins their cosine lobe reaches
     Vec2 normal;            // elements and sinks
     double length = 0;      // elements and sinks
 };
@@ -2433,6 +2434,7 @@ void HierarchicalSolver::collect_leaves() {
         o.kind = n.kind;
         o.leaf_cluster = n.leaf_cluster;
         o.normal = n.normal;
+        o.lobe = n.cluster() ? 0 : lobe_bins(n.normal);
         o.length = n.length;
         o.chain = n.chain;
         const Node* p = n.parent >= 0 ? &m_nodes[static_cast<size_t>(n.parent)] : nullptr;
@@ -2717,7 +2719,7 @@ void HierarchicalSolver::push_node(size_t k, TableArray& tables, const std::vect
         const float* g = gamma(static_cast<size_t>(n.parent));
         const double* samples = tables.samples(n.up_table);
         const double* linear = tables.linear(n.up_table);
-        above[k] += lobe_scale * (g ? read_cosine_lobe(samples, linear, n.normal, g) : read_cosine_lobe(samples, linear, n.normal));
+        above[k] += lobe_scale * (g ? read_cosine_lobe(samples, linear, n.normal, g, n.lobe) : read_cosine_lobe(samples, linear, n.normal, n.lobe));
     }
 }
 
