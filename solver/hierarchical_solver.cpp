@@ -295,7 +295,7 @@ struct OpNode {
     bool leaf_cluster = false;
     bool side = false;      // an element or sink right under a leaf cluster
     bool chain = false;     // Node::chain (a chain cluster's length is its elements')
-    uint32_t lobe = 0;      // elements and sinks: lobe_bins(normal), the bins their cosine lobe reaches
+    uint32_t lobe = 0;      // sides with an up_table: lobe_bins(normal), the bins their cosine lobe reaches
     Vec2 normal;            // elements and sinks
     double length = 0;      // elements and sinks
 };
@@ -2434,7 +2434,6 @@ void HierarchicalSolver::collect_leaves() {
         o.kind = n.kind;
         o.leaf_cluster = n.leaf_cluster;
         o.normal = n.normal;
-        o.lobe = n.cluster() ? 0 : lobe_bins(n.normal);
         o.length = n.length;
         o.chain = n.chain;
         const Node* p = n.parent >= 0 ? &m_nodes[static_cast<size_t>(n.parent)] : nullptr;
@@ -2444,6 +2443,7 @@ void HierarchicalSolver::collect_leaves() {
             o.up_table = p->table;
         else if (o.side && p->parent >= 0)
             o.up_table = m_nodes[static_cast<size_t>(p->parent)].table;
+        o.lobe = o.side && o.up_table >= 0 ? lobe_bins(n.normal) : 0;  // (push_node reads it there alone)
     }
     build_op_schedule();
 }
