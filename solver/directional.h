@@ -102,12 +102,19 @@ namespace directional_detail {
 struct Unscaled {
     double operator[](int) const { return 1.0; }
 };
+// n . u(phi_k) from d = bin_directions() (fetched once per loop, outside
+// it: a call per bin keeps the loops from vectorising), as every lobe
+// function below computes it: the same rounding everywhere, so that
+// lobe_bins' mask is where these are positive.
+inline double cosine_at(const std::array<Vec2, directional_bins>& d, Vec2 n, int k) {
+    return n.x * d[static_cast<size_t>(k)].x + n.y * d[static_cast<size_t>(k)].y;
+}
 template <class Scale>
 inline void add_lobe(double* samples, double* linear, Vec2 n, double w, const Scale& scale) {
     if (samples) {
         const auto& d = bin_directions();
         for (int k = 0; k < directional_bins; ++k) {
-            const double c = n.x * d[static_cast<size_t>(k)].x + n.y * d[static_cast<size_t>(k)].y;
+            const double c = cosine_at(d, n, k);
             samples[k] += w * scale[k] * std::max(c, 0.0);
         }
     }
@@ -120,7 +127,7 @@ inline double read_lobe(const double* samples, const double* linear, Vec2 n, con
     if (samples) {
         const auto& d = bin_directions();
         for (int k = 0; k < directional_bins; ++k) {
-            const double c = n.x * d[static_cast<size_t>(k)].x + n.y * d[static_cast<size_t>(k)].y;
+            const double c = cosine_at(d, n, k);
             s += scale[k] * samples[k] * std::max(c, 0.0);
         }
     }
@@ -138,7 +145,7 @@ inline double read_lobe_masked(const double* samples, const double* linear, Vec2
         const auto& d = bin_directions();
         for (uint32_t m = mask; m; m &= m - 1) {
             const int k = std::countr_zero(m);
-            const double c = n.x * d[static_cast<size_t>(k)].x + n.y * d[static_cast<size_t>(k)].y;
+            const double c = cosine_at(d, n, k);
             s += scale[k] * samples[k] * std::max(c, 0.0);
         }
     }
@@ -157,7 +164,7 @@ inline uint32_t lobe_bins(Vec2 n) {
     const auto& d = bin_directions();
     uint32_t mask = 0;
     for (int k = 0; k < directional_bins; ++k) {
-        const double c = n.x * d[static_cast<size_t>(k)].x + n.y * d[static_cast<size_t>(k)].y;
+        const double c = directional_detail::cosine_at(d, n, k);
         if (std::max(c, 0.0) > 0) mask |= uint32_t{1} << k;
     }
     return mask;
