@@ -5,6 +5,8 @@
 #include <limits>
 #include <vector>
 
+#include "engine/error.h"
+
 namespace flatrad {
 
 namespace {
@@ -36,19 +38,35 @@ void visible_fraction_exact(const Segment* segs, const uint8_t* sides, size_t n,
         double lo, hi, dlo, dhi;
         bool facing[2];  // along u, along -u
         bool blocker;
+        bool active;  // faces a way, across some width: its hidden parts are measured
     };
-    thread_local std::vector<Proj> pr;
-    thread_local std::vector<std::pair<double, double>> hidden[2];
-    pr.resize(n);
+    FLATRAD_ASSERT(n <= exact_up_to, "the exact path is for few segments");
+    Proj pr[exact_up_to];
+    // Per way and segment: the intervals of it hidden by blockers in front
+    // (at most one per other segment), and how many.
+    struct Span {
+        double a, b;
+        bool operator<(const Span& o) const { return a < o.a || (a == o.a && b < o.b); }
+    };
+    Span hidden[2][exact_up_to][exact_up_to - 1];  // (no initializer: written before read)
+    int count[2][exact_up_to];
     const auto& dirs = bin_directions();
     auto depth_at = [](const Proj& q, double p) {
         return q.hi > q.lo ? q.dlo + (p - q.lo) / (q.hi - q.lo) * (q.dhi - q.dlo) : std::max(q.dlo, q.dhi);
     };
-    // The length of [lo, hi] not covered by the intervals in h (sorted here).
-    auto uncovered = [](double lo, double hi, std::vector<std::pair<double, double>>& h) {
-        std::sort(h.begin(), h.end());
+    // The length of [lo, hi] not covered by the m intervals in h (sorted
+    // here; pairs in their total order, so that any sort gives the same
+    // sequence and the same sum).
+    auto uncovered = [](double lo, double hi, Span* h, int m) {
+        for (int x = 1; x < m; ++x) {  // (insertion: a few of them)
+            const Span key = h[x];
+            int y = x;
+            for (; y > 0 && key < h[y - 1]; --y) h[y] = h[y - 1];
+            h[y] = key;
+        }
         double at = lo, covered = 0;
-        for (const auto& [a, b] : h) {
+        for (int x = 0; x < m; ++x) {
+            const auto [a, b] = h[x];
             if (b <= at) continue;
             covered += b - std::max(a, at);
             at = b;
@@ -66,27 +84,46 @@ void visible_fraction_exact(const Segment* segs, const uint8_t* sides, size_t n,
                 std::swap(da, db);
             }
             const Facing f = facing_ways(s, sides[i], u);
-            pr[i] = {pa, pb, da, db, {f.way[0], f.way[1]}, (sides[i] & blocks) != 0};
+            pr[i] = {pa, pb, da, db, {f.way[0], f.way[1]}, (sides[i] & blocks) != 0, (f.way[0] || f.way[1]) && pb > pa};
         }
-        double seen[2] = {0, 0}, all[2] = {0, 0};
+        // Each pair once: its overlap, the midpoint and both depths there
+        // are the same whichever end asks, and the one in front along u is
+        // behind along -u. Pairs go in (i, j) order with i < j, so each
+        // segment's intervals arrive with the other end ascending, as a
+        // loop over j per segment would give them (the same sorted lists,
+        // bit for bit; half the pairs' work).
+        for (size_t i = 0; i < n; ++i) count[0][i] = count[1][i] = 0;
+        auto hide = [&](int w, size_t i, double lo, double hi) { hidden[w][i][count[w][i]++] = {lo, hi}; };
         for (size_t i = 0; i < n; ++i) {
             const Proj& a = pr[i];
-            if ((!a.facing[0] && !a.facing[1]) || !(a.hi > a.lo)) continue;
-            hidden[0].clear();
-            hidden[1].clear();
-            for (size_t j = 0; j < n; ++j) {
+            const bool a_active = a.active;
+            if (!a_active && !a.blocker) continue;
+            for (size_t j = i + 1; j < n; ++j) {
                 const Proj& b = pr[j];
-                if (j == i || !b.blocker) continue;
+                // i hidden by j needs i active and j a blocker; j by i the reverse.
+                const bool i_by_j = a_active && b.blocker, j_by_i = a.blocker && b.active;
+                if (!i_by_j && !j_by_i) continue;
                 const double lo = std::max(a.lo, b.lo), hi = std::min(a.hi, b.hi);
                 if (!(hi > lo)) continue;
                 const double mid = 0.5 * (lo + hi);
                 const double db = depth_at(b, mid), da = depth_at(a, mid);
-                if (a.facing[0] && db > da) hidden[0].emplace_back(lo, hi);  // in front along u
-                if (a.facing[1] && db < da) hidden[1].emplace_back(lo, hi);  // in front along -u
+                if (i_by_j) {
+                    if (a.facing[0] && db > da) hide(0, i, lo, hi);  // j in front along u
+                    if (a.facing[1] && db < da) hide(1, i, lo, hi);  // j in front along -u
+                }
+                if (j_by_i) {
+                    if (b.facing[0] && da > db) hide(0, j, lo, hi);
+                    if (b.facing[1] && da < db) hide(1, j, lo, hi);
+                }
             }
+        }
+        double seen[2] = {0, 0}, all[2] = {0, 0};
+        for (size_t i = 0; i < n; ++i) {
+            const Proj& a = pr[i];
+            if (!a.active) continue;
             for (int w = 0; w < 2; ++w)
                 if (a.facing[w]) {
-                    const double width = a.hi - a.lo, visible = uncovered(a.lo, a.hi, hidden[w]);
+                    const double width = a.hi - a.lo, visible = uncovered(a.lo, a.hi, hidden[w][i], count[w][i]);
                     all[w] += width;
                     seen[w] += visible;
                     if (dsum) dsum[k + w * half] += visible * (w == 0 ? 1 : -1) * 0.5 * (a.dlo + a.dhi);
