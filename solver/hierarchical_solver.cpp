@@ -658,6 +658,7 @@ private:
         return !part || m_part_of[static_cast<size_t>(parent)] == m_part_of[static_cast<size_t>(node)];
     }
     void solve(double tolerance = gmres_tolerance);
+    void row_sums();
     std::vector<double> leaf_guess() const;
     std::vector<double> landed_fraction() const;
     void push_down(TableArray& tables, const std::vector<double>& own, double lobe_scale,
@@ -811,6 +812,11 @@ private:
     long m_iterations = 0;
     int m_passes = 0;  // refine-solve rounds
     bool m_solved = false;  // m_B holds a solution (the next Krylov run starts from it)
+    // The operator may differ from the last solve's: a link was made,
+    // split, dropped or given its visibility since (refine). When not, the
+    // next solve keeps that solve's set-up (solve).
+    bool m_operator_changed = true;
+    long m_setups_kept = 0;
     long m_cluster_links = 0;
 };
 
@@ -2364,7 +2370,10 @@ bool HierarchicalSolver::refine(const std::vector<double>& leaf_bmax, double exi
                 exceeded = exceeded || above;
             }
         }
-        if (resolved > 0) m_ff_time += seconds_since(t_decide);
+        if (resolved > 0) {
+            m_ff_time += seconds_since(t_decide);
+            m_operator_changed = true;  // (a queried link's coefficient is new)
+        }
         // The first wave holds every link: if none exceeds eps_abs, the
         // round splits nothing (links that nothing passes are still dropped).
         if (first_wave && !exceeded)
@@ -2385,6 +2394,7 @@ bool HierarchicalSolver::refine(const std::vector<double>& leaf_bmax, double exi
                 continue;
             }
             const Link l = m_links[at];
+            m_operator_changed = true;
             if (decision[k] == 4) continue;  // dropped, not split
             any = true;
             if (decision[k] == 3) {
@@ -2781,14 +2791,9 @@ void HierarchicalSolver::apply_G(const Eigen::VectorXd& x, Eigen::VectorXd& out,
     }
 }
 
-// Solves to `tolerance` (relative residual, per part and channel) from
-// the previous solve's values; stats.residual is the last solve's.
-void HierarchicalSolver::solve(double tolerance) {
-    const auto t0 = Clock::now();
-    m_residual = 0;
-    collect_leaves();
-    sort_links();
-    sample_slots();
+// Row sums (see the header), per element leaf: m_deficit, m_anc_sum and
+// m_own_sum for the current links.
+void HierarchicalSolver::row_sums() {
     const Eigen::Index n = static_cast<Eigen::Index>(m_element_leaves);
     // Row sums: a leaf of a patch whose light cannot leave the scene and
     // that sees no sink must gather exactly 1 for B = 1 everywhere. Probed
@@ -2808,6 +2813,29 @@ void HierarchicalSolver::solve(double tolerance) {
             m_own_sum[static_cast<size_t>(i)] = m_Hn[static_cast<size_t>(node)];
         }
     }
+}
+
+// Solves to `tolerance` (relative residual, per part and channel) from
+// the previous solve's values; stats.residual is the last solve's.
+void HierarchicalSolver::solve(double tolerance) {
+    const auto t0 = Clock::now();
+    m_residual = 0;
+    // The same operator as the last solve's (the last refinement changed
+    // no link: the final solve after a round that splits nothing): its
+    // leaves, receivers, row sums and parts stand; only the table layout
+    // is laid out again (the refinement pulled every table). Only when that
+    // solve's flow check dropped no link (m_flow_simple): its row sums were
+    // probed with the links it then had, which are these.
+    const bool same_operator = m_opt.keep_unchanged_setup && m_solved && !m_operator_changed && m_flow_simple;
+    m_setups_kept += same_operator ? 1 : 0;
+    m_operator_changed = false;
+    if (!same_operator) {
+        collect_leaves();
+        sort_links();
+    }
+    sample_slots();
+    const Eigen::Index n = static_cast<Eigen::Index>(m_element_leaves);
+    if (!same_operator) row_sums();
     // Light flow and independent parts. Refinement only splits links
     // (each child joins nodes below the ends of its parent), so what light
     // reaches can only shrink and parts only come apart: when the last
@@ -2829,7 +2857,9 @@ void HierarchicalSolver::solve(double tolerance) {
     // only links that carry nothing), so the check would find every patch
     // reached, no dark link, and one part. (The test compares with the
     // check run.) A round room of 10^6 walls saves ~0.8 s.
-    if (!m_solved && m_convex_room) {
+    if (same_operator) {
+        // (The parts and the flow's counts are the last solve's.)
+    } else if (!m_solved && m_convex_room) {
         m_left_out = 0;
         m_dark_links = 0;
         m_part_count = 1;
@@ -3180,6 +3210,7 @@ Solution HierarchicalSolver::run() {
     sol.stats.iterations = m_iterations;
     sol.stats.unqueried_links = std::count_if(m_links.begin(), m_links.end(), [](const Link& l) { return l.vis_pending; });
     sol.stats.passes = m_passes;
+    sol.stats.setups_kept = m_setups_kept;
     sol.stats.emission_first = m_emission_first && m_passes > 0;
     sol.stats.residual = m_residual;
     sol.stats.threads = m_threads;

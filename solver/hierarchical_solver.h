@@ -243,6 +243,12 @@ struct HierarchicalOptions {
     /// visibility module, which would find the shaft empty (the same
     /// answer); off: every such link asks (for tests: the oracle).
     bool clear_shaft_shortcut = true;
+    /// A solve after a refinement that changed no link (the final one,
+    /// after a round that splits nothing) keeps the last solve's set-up:
+    /// its leaves, receivers sorted, row sums and parts
+    /// (stats.setups_kept); off: every solve sets up anew (for tests: the
+    /// oracle, bit for bit).
+    bool keep_unchanged_setup = true;
     /// Segments that cannot block (on the scene's hull: engine/
     /// convex_scene.h) may share the cluster hierarchy's leaves ("Leaves"
     /// above): up to this many (>= 1), or with 0 (the default) 8 where
