@@ -2791,14 +2791,14 @@ void HierarchicalSolver::apply_G(const Eigen::VectorXd& x, Eigen::VectorXd& out,
     }
 }
 
-// Row sums (see the header), per element leaf: m_deficit, m_anc_sum and
-// m_own_sum for the current links.
+// Row sums (see the header), per element leaf, for the current links
+// (m_deficit, m_anc_sum, m_own_sum): a leaf of a patch whose light cannot
+// leave the scene and that sees no sink must gather exactly 1 for B = 1
+// everywhere. Probed with every link, before drop_dark() drops those from
+// dark senders (they are part of the leaf's geometry, and carry 0 in the
+// solve).
 void HierarchicalSolver::row_sums() {
     const Eigen::Index n = static_cast<Eigen::Index>(m_element_leaves);
-    // Row sums: a leaf of a patch whose light cannot leave the scene and
-    // that sees no sink must gather exactly 1 for B = 1 everywhere. Probed
-    // with every link, before drop_dark() drops those from dark senders (they
-    // are part of the leaf's geometry, and carry 0 in the solve).
     m_deficit.assign(static_cast<size_t>(n), 0.0);
     m_anc_sum.assign(static_cast<size_t>(n), 0.0);
     m_own_sum.assign(static_cast<size_t>(n), 0.0);

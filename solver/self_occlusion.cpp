@@ -96,12 +96,11 @@ void visible_fraction_exact(const Segment* segs, const uint8_t* sides, size_t n,
         auto hide = [&](int w, size_t i, double lo, double hi) { hidden[w][i][count[w][i]++] = {lo, hi}; };
         for (size_t i = 0; i < n; ++i) {
             const Proj& a = pr[i];
-            const bool a_active = a.active;
-            if (!a_active && !a.blocker) continue;
+            if (!a.active && !a.blocker) continue;
             for (size_t j = i + 1; j < n; ++j) {
                 const Proj& b = pr[j];
                 // i hidden by j needs i active and j a blocker; j by i the reverse.
-                const bool i_by_j = a_active && b.blocker, j_by_i = a.blocker && b.active;
+                const bool i_by_j = a.active && b.blocker, j_by_i = a.blocker && b.active;
                 if (!i_by_j && !j_by_i) continue;
                 const double lo = std::max(a.lo, b.lo), hi = std::min(a.hi, b.hi);
                 if (!(hi > lo)) continue;

@@ -10,8 +10,6 @@
 
 namespace flatrad::test {
 
-// Every visibility counter, the links and the radiosity of every element,
-// compared exactly (no tolerance: the claim is bit-for-bit equality).
 inline void check_same(const Solution& a, const Solution& b) {
     const VisibilityStats &u = a.stats.visibility, &v = b.stats.visibility;
     CHECK(a.stats.links == b.stats.links);
