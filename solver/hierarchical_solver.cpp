@@ -5,6 +5,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <chrono>
 #include <cstddef>
 #include <cmath>
@@ -72,6 +73,11 @@ constexpr size_t gather_min_links = 32768;
 // Chain links are made in rooms holding at most this many segments that
 // may block, each checked against each chain link (chain_clear).
 constexpr long max_chain_blockers = 64;
+// An element pair's answer is kept for the other way (element_exchange)
+// when its shaft held at least this many blocker pieces, or when bands,
+// bounds or sub-shafts answered it: below, a query takes a few
+// microseconds, about what keeping and finding it costs.
+constexpr long shared_pair_work = 16;
 
 // Multi-scale visibility approximates clusters only in shafts holding at
 // least this many blocker pieces: below it, the criterion's set-up and the
@@ -630,6 +636,7 @@ private:
     double unoccluded_coef(const Node& r, const Node& s) const;
     double prior_transmittance(const Node& r, const Node& s) const;
     bool resolve_visibility(Link& l, ExactWorkspace& ws, VisibilityStats& st) const;
+    MultiscaleResult element_exchange(int r, int s, ExactWorkspace& ws, VisibilityStats& st) const;
     double kernel_variation(const Node& r, const Node& s, double Fu) const;
     std::pair<double, double> link_transmittance(int r, int s, ExactWorkspace& ws, VisibilityStats& st) const;
     bool behind_closure_screen(int e, const Box& region, ExactWorkspace& ws, VisibilityStats& st) const;
@@ -704,6 +711,12 @@ private:
     };
     mutable std::unordered_map<uint64_t, TauEntry> m_tau_cache;
     mutable std::shared_mutex m_tau_mutex;
+    // Element pairs' answers kept for the other way (element_exchange),
+    // keyed by the query's receiver and sender; per node, whether one of
+    // its pairs is kept (read and written as atomics; sized between waves).
+    mutable std::unordered_map<uint64_t, std::pair<double, double>> m_pair_cache;
+    mutable std::shared_mutex m_pair_mutex;
+    mutable std::vector<uint8_t> m_pair_kept;
     uint32_t m_wave = 0;  // refinement waves so far (refine, one per wave)
     // Closure screens (behind_closure_screen): per element node and depth
     // (the key: node x the depths' count + the depth's index), per direction
@@ -1660,8 +1673,7 @@ bool HierarchicalSolver::resolve_visibility(Link& l, ExactWorkspace& ws, Visibil
             return false;
         }
         const double Fu = form_factor_unoccluded(nr.seg, ns.seg);  // (make_link's)
-        const MultiscaleResult m = m_vis.form_factor(nr.seg, ns.seg, nr.segment, ns.segment, m_vis_eps,
-                                                     GammaRule::Bound, ws, st);
+        const MultiscaleResult m = element_exchange(l.r, l.s, ws, st);
         // Nothing in the shaft (rounding aside: 4 ulps of F): nor in its halves'.
         l.clear = m.error_bound == 0 && std::abs(m.F - Fu) <= 4 * std::numeric_limits<double>::epsilon() * Fu;
         if (!(m.F > 0) && m.error_bound == 0) {
@@ -1686,6 +1698,81 @@ bool HierarchicalSolver::resolve_visibility(Link& l, ExactWorkspace& ws, Visibil
     l.Fu = 0;
     l.coef = unoccluded_coef(nr, ns) * tau.value;
     return true;
+}
+
+// F_rs between two elements with its bound (MultiscaleVisibility::
+// form_factor at the visibility tolerance). The links r <- s and s <- r
+// may share one query by reciprocity, L_r F_rs = L_s F_sr (on the
+// 1000-segment forest at eps 12, 44 of the 432 element pairs asked were
+// asked both ways, the room's facing walls among them at 1.4-2 ms a
+// query). A pair is asked in one order whichever link asks (the answers
+// must not depend on the threads' timing): the shorter element as the
+// receiver (on a tie, the lower node), so that the tolerance on F holds
+// both ways, the other way's F and bound being these times L_r / L_s <= 1.
+// Only answers that cost work are kept for the other way (shared_pair_work):
+// most pairs are asked once, and in a room of furniture most queries take
+// microseconds, of the order of the map and its lock (kept for all: the
+// room's 88 000 queries, 12% fewer, took 11% longer). A node's flag says
+// that one of its pairs is kept; the map is read only when both ends have
+// one. A flag or an entry not there yet (the other way asked at the same
+// moment on another thread) costs the query again, the same answer; only
+// the first kept answer's work is counted.
+MultiscaleResult HierarchicalSolver::element_exchange(int r, int s, ExactWorkspace& ws, VisibilityStats& st) const {
+    const Node& nr = m_nodes[static_cast<size_t>(r)];
+    const Node& ns = m_nodes[static_cast<size_t>(s)];
+    if (!m_opt.share_element_pairs)
+        return m_vis.form_factor(nr.seg, ns.seg, nr.segment, ns.segment, m_vis_eps, GammaRule::Bound, ws, st);
+    const double Lr = nr.seg.length(), Ls = ns.seg.length();
+    const bool as_asked = Lr < Ls || (Lr == Ls && r < s);
+    const Node& ni = as_asked ? nr : ns;  // the query's receiver
+    const Node& nj = as_asked ? ns : nr;
+    const size_t i = static_cast<size_t>(as_asked ? r : s), j = static_cast<size_t>(as_asked ? s : r);
+    const uint64_t key = (static_cast<uint64_t>(i) << 32) | static_cast<uint32_t>(j);
+    auto flag = [&](size_t node) { return std::atomic_ref<uint8_t>(m_pair_kept[node]); };
+    MultiscaleResult m;
+    bool known = false;
+    if (flag(i).load(std::memory_order_acquire) && flag(j).load(std::memory_order_acquire)) {
+        std::shared_lock lock(m_pair_mutex);
+        const auto it = m_pair_cache.find(key);
+        if (it != m_pair_cache.end()) {
+            m.F = it->second.first;
+            m.error_bound = it->second.second;
+            known = true;
+        }
+    }
+    if (!known) {
+        VisibilityStats mine;
+        m = m_vis.form_factor(ni.seg, nj.seg, ni.segment, nj.segment, m_vis_eps, GammaRule::Bound, ws, mine);
+        const bool worth = mine.blockers >= shared_pair_work ||
+                           mine.bounded + mine.banded + mine.opaque + mine.subshafts > 0;
+        if (!worth) {
+            st += mine;
+        } else {
+            bool first;
+            {
+                std::unique_lock lock(m_pair_mutex);
+                first = m_pair_cache.emplace(key, std::make_pair(m.F, m.error_bound)).second;
+            }
+            if (first) {
+                st += mine;
+                flag(i).store(1, std::memory_order_release);
+                flag(j).store(1, std::memory_order_release);
+            }
+        }
+    }
+    if (as_asked) return m;
+    // A clear shaft (nothing in it, rounding aside: resolve_visibility's
+    // test) is clear both ways: the unoccluded F of this way, as its own
+    // query would give it.
+    const double Fu_asked = form_factor_unoccluded(ni.seg, nj.seg);
+    if (m.error_bound == 0 && std::abs(m.F - Fu_asked) <= 4 * std::numeric_limits<double>::epsilon() * Fu_asked) {
+        m.F = form_factor_unoccluded(nj.seg, ni.seg);  // (F_rs: r is nj)
+        return m;
+    }
+    const double scale = ni.seg.length() / nj.seg.length();  // L_s / L_r, at most 1
+    m.F *= scale;
+    m.error_bound *= scale;
+    return m;
 }
 
 // Transmittance (and its bound) for a cluster link between nodes r and s,
@@ -2285,6 +2372,7 @@ bool HierarchicalSolver::refine(const std::vector<double>& leaf_bmax, double exi
         const auto t_decide = Clock::now();
         long resolved = 0;
         ++m_wave;  // (link_transmittance: answers of this wave are not shortcuts within it)
+        m_pair_kept.resize(m_nodes.size(), 0);  // (element_exchange: the nodes split since)
 #pragma omp parallel num_threads(m_threads) if (nw > parallel_min_work)
         {
             ExactWorkspace ws;

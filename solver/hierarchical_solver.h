@@ -249,6 +249,11 @@ struct HierarchicalOptions {
     /// (stats.setups_kept); off: every solve sets up anew (for tests: the
     /// oracle, bit for bit).
     bool keep_unchanged_setup = true;
+    /// The links r <- s and s <- r between two elements share one
+    /// visibility query (the shorter element its receiver, the other way's
+    /// answer by reciprocity, L_r F_rs = L_s F_sr); off: each link asks its
+    /// own (for tests: the oracle).
+    bool share_element_pairs = true;
     /// Segments that cannot block (on the scene's hull: engine/
     /// convex_scene.h) may share the cluster hierarchy's leaves ("Leaves"
     /// above): up to this many (>= 1), or with 0 (the default) 8 where
