@@ -451,6 +451,12 @@ Estimate within_bound(double answer, double bound, double top, const EstimateFn&
     return {v, f};
 }
 
+// A query's answer is a clear shaft: exact (no bound) and the unoccluded
+// F, rounding aside (4 ulps of it).
+bool clear_answer(double F, double bound, double Fu) {
+    return bound == 0 && std::abs(F - Fu) <= 4 * std::numeric_limits<double>::epsilon() * Fu;
+}
+
 Link link_between(int r, int s) {
     Link l;
     l.r = r;
@@ -636,7 +642,7 @@ private:
     double unoccluded_coef(const Node& r, const Node& s) const;
     double prior_transmittance(const Node& r, const Node& s) const;
     bool resolve_visibility(Link& l, ExactWorkspace& ws, VisibilityStats& st) const;
-    MultiscaleResult element_exchange(int r, int s, ExactWorkspace& ws, VisibilityStats& st) const;
+    MultiscaleResult element_exchange(int r, int s, double Fu, ExactWorkspace& ws, VisibilityStats& st) const;
     double kernel_variation(const Node& r, const Node& s, double Fu) const;
     std::pair<double, double> link_transmittance(int r, int s, ExactWorkspace& ws, VisibilityStats& st) const;
     bool behind_closure_screen(int e, const Box& region, ExactWorkspace& ws, VisibilityStats& st) const;
@@ -1673,9 +1679,9 @@ bool HierarchicalSolver::resolve_visibility(Link& l, ExactWorkspace& ws, Visibil
             return false;
         }
         const double Fu = form_factor_unoccluded(nr.seg, ns.seg);  // (make_link's)
-        const MultiscaleResult m = element_exchange(l.r, l.s, ws, st);
-        // Nothing in the shaft (rounding aside: 4 ulps of F): nor in its halves'.
-        l.clear = m.error_bound == 0 && std::abs(m.F - Fu) <= 4 * std::numeric_limits<double>::epsilon() * Fu;
+        const MultiscaleResult m = element_exchange(l.r, l.s, Fu, ws, st);
+        // Nothing in the shaft: nor in its halves'.
+        l.clear = clear_answer(m.F, m.error_bound, Fu);
         if (!(m.F > 0) && m.error_bound == 0) {
             l.coef = 0;
             return false;
@@ -1717,7 +1723,9 @@ bool HierarchicalSolver::resolve_visibility(Link& l, ExactWorkspace& ws, Visibil
 // one. A flag or an entry not there yet (the other way asked at the same
 // moment on another thread) costs the query again, the same answer; only
 // the first kept answer's work is counted.
-MultiscaleResult HierarchicalSolver::element_exchange(int r, int s, ExactWorkspace& ws, VisibilityStats& st) const {
+// Fu: F_rs unoccluded (the caller's).
+MultiscaleResult HierarchicalSolver::element_exchange(int r, int s, double Fu, ExactWorkspace& ws,
+                                                      VisibilityStats& st) const {
     const Node& nr = m_nodes[static_cast<size_t>(r)];
     const Node& ns = m_nodes[static_cast<size_t>(s)];
     if (!m_opt.share_element_pairs)
@@ -1761,12 +1769,10 @@ MultiscaleResult HierarchicalSolver::element_exchange(int r, int s, ExactWorkspa
         }
     }
     if (as_asked) return m;
-    // A clear shaft (nothing in it, rounding aside: resolve_visibility's
-    // test) is clear both ways: the unoccluded F of this way, as its own
-    // query would give it.
-    const double Fu_asked = form_factor_unoccluded(ni.seg, nj.seg);
-    if (m.error_bound == 0 && std::abs(m.F - Fu_asked) <= 4 * std::numeric_limits<double>::epsilon() * Fu_asked) {
-        m.F = form_factor_unoccluded(nj.seg, ni.seg);  // (F_rs: r is nj)
+    // A clear shaft is clear both ways: the unoccluded F of this way, as
+    // its own query would give it.
+    if (m.error_bound == 0 && clear_answer(m.F, 0, form_factor_unoccluded(ni.seg, nj.seg))) {
+        m.F = Fu;
         return m;
     }
     const double scale = ni.seg.length() / nj.seg.length();  // L_s / L_r, at most 1

@@ -14,7 +14,7 @@
 #include "support/relative_l2.h"
 
 using namespace flatrad;
-using flatrad::test::forest_json;
+using flatrad::test::forest900;
 using flatrad::test::relative_l2;
 
 namespace {
@@ -56,7 +56,7 @@ TEST_CASE("hierarchical element pairs: one query serves both links of a pair, an
     Queries total;
     for (unsigned seed : {1u, 2u}) {
         CAPTURE(seed);
-        const Scene scene = parse_scene(forest_json(900, 3, 3, seed), fmt::format("forest900-{}.json", seed));
+        const Scene scene = forest900(seed);
         for (double eps : {12.0, 2.0}) {
             HierarchicalOptions o;
             o.eps = eps;

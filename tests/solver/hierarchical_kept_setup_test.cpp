@@ -16,7 +16,7 @@
 
 using namespace flatrad;
 using flatrad::test::check_same;
-using flatrad::test::forest_json;
+using flatrad::test::forest900;
 
 namespace {
 
@@ -43,7 +43,7 @@ TEST_CASE("hierarchical kept set-up: forests and data scenes, the same solution 
     long kept = 0;
     for (unsigned seed : {1u, 2u}) {
         CAPTURE(seed);
-        const Scene scene = parse_scene(forest_json(900, 3, 3, seed), fmt::format("forest900-{}.json", seed));
+        const Scene scene = forest900(seed);
         for (double eps : {12.0, 2.0}) {
             HierarchicalOptions o;
             o.eps = eps;

@@ -13,7 +13,7 @@
 #include "support/relative_l2.h"
 
 using namespace flatrad;
-using flatrad::test::forest_json;
+using flatrad::test::forest900;
 using flatrad::test::relative_l2;
 
 TEST_CASE("hierarchical solver: loose solves between rounds end at the full residual, with fewer applications") {
@@ -34,7 +34,7 @@ TEST_CASE("hierarchical solver: loose solves between rounds end at the full resi
     constexpr double residual_bar = 1e-11, same_solution = 1e-3;
     for (unsigned seed : {1u, 2u}) {
         CAPTURE(seed);
-        const Scene scene = parse_scene(forest_json(900, 3, 3, seed), "forest900.json");
+        const Scene scene = forest900(seed);
         HierarchicalOptions o;
         o.eps = 5;
         const Solution loose = solve_hierarchical(scene, o);

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "engine/geometry.h"
+#include "engine/scene.h"
 
 namespace flatrad::test {
 
@@ -75,6 +76,12 @@ inline std::string forest_json(int sticks, double width, double height, unsigned
     REQUIRE(static_cast<int>(placed.size()) == sticks);
     return R"({"flatrad": 1, "materials": {"wall": {"reflectance": 0.7}, "tree": {"reflectance": 0.3},
         "lamp": {"reflectance": 0, "emission": 10}}, "surfaces": [)" + surfaces + "]}";
+}
+
+// The 900-stick forest in a 3 x 3 room that several solver tests compare
+// options on, for a seed.
+inline Scene forest900(unsigned seed) {
+    return parse_scene(forest_json(900, 3, 3, seed), fmt::format("forest900-{}.json", seed));
 }
 
 }  // namespace flatrad::test
