@@ -61,8 +61,12 @@ constexpr long parallel_min_work = 64;
 // the 10^5 forest 2.75 / 3.10 s against 3.01 / 3.82 s (one run each); the
 // 1000-segment forest (4000 nodes) at eps 5 within the noise (8-13 ms);
 // a round room of 10^5 walls the same (0.21 s: its solves are not in these
-// passes).
-constexpr size_t op_parallel_min_nodes = 2048;
+// passes). From 2048 nodes to 8192 (thirtieth session): that forest at eps
+// 12, a pass of 0.07 ms split over two threads costs more in waking the
+// second one than it saves (the solves 14-15 ms on one thread, 18-25 ms
+// on two, phase timers; `flatrad_bench versus --eps-list 12 --repeat 15`
+// twice, alternating: 0.054 / 0.059 s against 0.061 / 0.067 s).
+constexpr size_t op_parallel_min_nodes = 8192;
 // The gather runs on both cores only above this many links: below, one
 // gather is tens of microseconds, of the order of waking the other thread
 // (2 cores, medians of 10 / 5 runs, GMRES time: the 1000-segment forest at

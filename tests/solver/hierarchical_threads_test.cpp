@@ -71,7 +71,7 @@ TEST_CASE("hierarchical threads: closure screens give the same solution with one
 }
 
 TEST_CASE("hierarchical threads: the operator's passes split over subtrees give one thread's sums") {
-    // From 2048 nodes on, with two threads, pull_tables and push_down run
+    // From 8192 nodes on, with two threads, pull_tables and push_down run
     // disjoint subtrees side by side and the nodes above them on one
     // thread (hierarchical_solver.cpp, OpSchedule). Every table must get
     // its children's shares in one thread's order: a share added out of
@@ -79,11 +79,11 @@ TEST_CASE("hierarchical threads: the operator's passes split over subtrees give 
     // A round room with a lamp inside, at a tight eps: walls cut into
     // elements several levels deep (subtrees of elements under a leaf),
     // chains, tables both ways.
-    const Scene ring = flatrad::test::ring_scene(3000, 0.7, 0.0, true);
+    const Scene ring = flatrad::test::ring_scene(9000, 0.7, 0.0, true);
     HierarchicalOptions o;
     o.eps = 1e-3;
     const Solution one = check_thread_independent(ring, o, 3);
     // (What this case is for: elements are nodes, so the operator has more
-    // than the 2048 nodes from which it is split.)
-    CHECK(one.stats.elements > 2048);
+    // than the 8192 nodes from which it is split.)
+    CHECK(one.stats.elements > 8192);
 }
