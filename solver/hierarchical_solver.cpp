@@ -2944,7 +2944,12 @@ void HierarchicalSolver::solve(double tolerance) {
     // room of 10^6 walls spent ~1.1 s per solve here.
     // The flow's search runs on a second thread while the parts are found
     // over the same links; if it finds dark links, they are dropped and the
-    // parts found again (1.2 -> 0.7 s at 10^6 walls).
+    // parts found again (1.2 -> 0.7 s at 10^6 walls). The second thread is
+    // the OpenMP team's, not a thread of its own: right after a refinement
+    // round the team's idle thread still spins on the other core, and a new
+    // thread waited for it (the 1000-segment forest at eps 12: 4-5.8 ms for
+    // the first solve's flow and parts, 0.8-0.9 ms now; `flatrad solve`,
+    // alternating, medians of 15: 77.9 ms against 82.1 ms).
     // A convex room (m_convex_room) needs no check at all. Every segment
     // lies on the hull's boundary and every patch is escape-free, so the
     // patches are the inner sides of a convex polygon's walls, and two
@@ -2963,9 +2968,15 @@ void HierarchicalSolver::solve(double tolerance) {
         m_part_count = 1;
         m_flow_simple = true;
     } else if (!m_solved || !m_flow_simple) {
-        std::future<std::vector<char>> flow = std::async(std::launch::async, [this] { return light_flow(); });
-        build_parts();
-        drop_dark(flow.get());  // drops links, keeping the order: still sorted by receiver
+        std::vector<char> flow;
+#pragma omp parallel sections num_threads(std::min(m_threads, 2))
+        {
+#pragma omp section
+            flow = light_flow();
+#pragma omp section
+            build_parts();
+        }
+        drop_dark(flow);  // drops links, keeping the order: still sorted by receiver
         if (m_dark_links > 0) {
             index_receivers();  // (the slots above still hold every table a link uses)
             build_parts();
