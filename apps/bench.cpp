@@ -59,6 +59,8 @@
 
 extern char** environ;
 
+FLATRAD_USE_LARGE_PAGES  // as the flatrad program (versus runs the solvers in-process)
+
 namespace {
 
 using flatrad::Box;
@@ -1368,7 +1370,7 @@ int run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
-    flatrad::use_large_pages();  // as the flatrad program (versus runs the solvers in-process)
+    flatrad::use_large_pages_in_main();
     try {
         return run(argc, argv);
     } catch (const UsageError& e) {
