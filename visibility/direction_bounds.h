@@ -52,6 +52,15 @@ inline OffsetInterval held(double p, double dp, double q, double dq) {
     return {std::min(p + dp, q + dq), std::max(p - dp, q - dq)};
 }
 
+/// The length of `window` that the first m `shadows` (each with b > a and
+/// meeting the window) leave uncovered, summed gap by gap from left to
+/// right; once the sum exceeds `budget`, that partial sum (> budget). The
+/// same number, bit for bit, as sorting the shadows by start and sweeping
+/// (which it does past a few gaps; the shadows may be reordered). A bin's
+/// free lengths here (budget +infinity) and a band section's check
+/// (opaque_band.h), where a dense forest covers the window in a few hops.
+double gaps_in_window(OffsetInterval window, OffsetInterval* shadows, size_t m, double budget);
+
 /// Scratch memory of one thread.
 struct DirectionBoundsScratch {
     std::vector<Vec2> points;

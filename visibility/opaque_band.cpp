@@ -3,56 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <span>
 
 #include "visibility/shaft.h"
 
 namespace flatrad {
-
-double gaps_in_window(OffsetInterval window, OffsetInterval* shadows, size_t m, double budget) {
-    double reach = window.a, free = 0;
-    // First by hops, without sorting: from `reach`, the farthest end of the
-    // shadows that start at or before it extends the union; where none
-    // does, the nearest start beyond it ends a gap. The gaps are the sweep's
-    // below (from the union's end to the next start, in the same order), so
-    // the sum is the same bit for bit, returned at the same points. A band's
-    // section is covered in a few hops of a shadow's length each, one
-    // branch-free pass over the shadows each, where sorting them compares
-    // each ~log2(m) times; a section with many gaps takes many hops, so
-    // past hop_budget the sweep takes over from where the hops stopped (a
-    // shadow starting at or before `reach` only extends the union there, as
-    // it would have in the sweep).
-    constexpr int hop_budget = 12;
-    constexpr double none = std::numeric_limits<double>::infinity();
-    for (int hop = 0; hop < hop_budget; ++hop) {
-        double far = reach, next = none;
-        for (size_t it = 0; it < m; ++it) {
-            const OffsetInterval& sh = shadows[it];
-            const bool started = sh.a <= reach;
-            far = started && sh.b > far ? sh.b : far;
-            next = !started && sh.a < next ? sh.a : next;
-        }
-        if (far > reach) {
-            reach = far;
-            if (reach >= window.b) return free;
-            continue;
-        }
-        if (next == none) return free + (window.b - reach);
-        free += next - reach;
-        if (free > budget) return free;
-        reach = next;  // (the next hop extends it over the shadows starting there)
-    }
-    std::sort(shadows, shadows + m, [](const OffsetInterval& x, const OffsetInterval& y) { return x.a < y.a; });
-    for (const OffsetInterval& sh : std::span<const OffsetInterval>(shadows, m)) {
-        if (sh.a > reach) {
-            free += sh.a - reach;
-            if (free > budget) return free;
-        }
-        reach = std::max(reach, sh.b);
-        if (reach >= window.b) return free;
-    }
-    return free + (window.b - reach);
-}
 
 namespace {
 

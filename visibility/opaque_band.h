@@ -189,14 +189,6 @@ bool narrower_at_i(const Segment& ci, const Segment& cj);
 double band_bound(const Segment& ci, const Segment& cj, const Segment* blockers, size_t count,
                   const BandOptions& options, OpaqueBandScratch& scratch);
 
-/// The length of `window` that the first m `shadows` (each with b > a and
-/// meeting the window) leave uncovered, summed gap by gap from left to
-/// right; once the sum exceeds `budget`, that partial sum (> budget). The
-/// same number, bit for bit, as sorting the shadows by start and sweeping
-/// (which it does past a few gaps; the shadows may be reordered). A
-/// section check's last step (band_bound above), exposed for its test.
-double gaps_in_window(OffsetInterval window, OffsetInterval* shadows, size_t m, double budget);
-
 /// True when the blockers are shown to stop every line from ci to cj
 /// (band_bound with limit 0 and the proof's settings).
 inline bool band_closes_shaft(const Segment& ci, const Segment& cj, const Segment* blockers, size_t count,

@@ -1,8 +1,10 @@
 // apps/large_pages.h: a program linked as the flatrad tool is (with
 // flatrad_allocator) allocates through mimalloc, with large OS pages on
-// unless the environment says otherwise. Built without mimalloc
-// (FLATRAD_MIMALLOC off, the package missing, or the sanitizers), the
-// programs use the system malloc and there is nothing to check.
+// unless the environment says otherwise, set before main() (before the
+// first allocation: the main thread's first segment is mapped then).
+// Built without mimalloc (FLATRAD_MIMALLOC off, the package missing, or
+// the sanitizers), the programs use the system malloc and there is
+// nothing to check.
 #include <doctest/doctest.h>
 
 #include <cstdlib>
@@ -11,14 +13,38 @@
 
 #include "large_pages.h"
 
+FLATRAD_USE_LARGE_PAGES  // as apps/flatrad.cpp does
+
 #if FLATRAD_WITH_MIMALLOC
-TEST_CASE("the programs' operator new and malloc are mimalloc's, with large OS pages") {
-    const bool env_set = flatrad::large_pages_set_by_environment();
-    flatrad::use_large_pages();
-    if (!env_set) CHECK(mi_option_is_enabled(mi_option_large_os_pages));
+namespace {
+// Read by a dynamic initializer: these run after every library's
+// constructors (mimalloc's included) and before main(), so the option is
+// already on here only if .preinit_array set it, ahead of all of them.
+const bool on_before_main = mi_option_is_enabled(mi_option_large_os_pages);
+}  // namespace
+
+TEST_CASE("the environment's setting of large pages is found in envp") {
+    char a[] = "PATH=/bin", b[] = "MIMALLOC_LARGE_OS_PAGES=0", c[] = "mimalloc_large_os_pages=1",
+         d[] = "MIMALLOC_LARGE_OS_PAGESX=1", e[] = "XMIMALLOC_LARGE_OS_PAGES=1";
+    char* none[] = {a, d, e, nullptr};
+    char* upper[] = {a, b, nullptr};
+    char* lower[] = {c, a, nullptr};
+    CHECK_FALSE(flatrad::large_pages_set_by_environment(none));
+    CHECK(flatrad::large_pages_set_by_environment(upper));
+    CHECK(flatrad::large_pages_set_by_environment(lower));
+    CHECK_FALSE(flatrad::large_pages_set_by_environment(nullptr));
+}
+
+TEST_CASE("the programs' operator new and malloc are mimalloc's, with large OS pages from before main") {
+    const char* env = std::getenv("MIMALLOC_LARGE_OS_PAGES");
+    if (!env) env = std::getenv("mimalloc_large_os_pages");
+#if defined(__ELF__) && defined(__linux__)
+    if (!env) CHECK(on_before_main);
+#endif
+    flatrad::use_large_pages_in_main();
+    if (!env) CHECK(mi_option_is_enabled(mi_option_large_os_pages));
     // The environment's word stands (MIMALLOC_LARGE_OS_PAGES=0: none).
-    const char* off = std::getenv("MIMALLOC_LARGE_OS_PAGES");
-    if (off && std::string(off) == "0") CHECK_FALSE(mi_option_is_enabled(mi_option_large_os_pages));
+    if (env && std::string(env) == "0") CHECK_FALSE(mi_option_is_enabled(mi_option_large_os_pages));
     // The override is in effect (a link order that left glibc's malloc
     // first would fail these): small and large blocks, through new and
     // through malloc, come from mimalloc's heap.
