@@ -32,6 +32,7 @@
 #include "solver/light_parts.h"
 #include "solver/reachability.h"
 #include "solver/rooms.h"
+#include "solver/front_envelopes.h"
 #include "solver/self_occlusion.h"
 #include "solver/sink_visibility.h"
 #include "solver/table_array.h"
@@ -1072,7 +1073,12 @@ void HierarchicalSolver::build_tree() {
 
 // Occlusion inside clusters (solver/self_occlusion.h). Per table cluster,
 // per direction bin: A, the share of its members' lobes seen from outside
-// it (visible_fraction), so that its sensitivity is A x the lobes' sum;
+// it (visible_fraction's measure, for every cluster at once by merged
+// front envelopes: solver/front_envelopes.h; exact, where measuring each
+// cluster alone sampled those of more than exact_up_to members on lines:
+// on the 1000-segment forest 5.3 ms against 12 ms on one thread, 4.5 ms
+// against 6.2 ms on two, the same error against exact), so that its
+// sensitivity is A x the lobes' sum;
 // and, per child, the share of that child's lobes seen from outside the
 // cluster (the same depth buffer, by groups). The operator applies it edge
 // by edge: a child's gamma is its share seen from outside its parent over
@@ -1118,46 +1124,42 @@ void HierarchicalSolver::self_occlusion() {
         const Node& n = m_nodes[static_cast<size_t>(k)];
         for (int ch = n.child; ch < n.child + n.nchild; ++ch) slot[static_cast<size_t>(ch)] = slots++;
     }
-    std::vector<double> A(static_cast<size_t>(m_tables_count) * K, 1.0);
-    std::vector<double> seen(static_cast<size_t>(slots) * K, 1.0);  // per child: its lobes' share seen from outside its parent
-    std::vector<double> face(static_cast<size_t>(m_tables_count) * K, 0.0);
-    const long C = static_cast<long>(clusters.size());
-#pragma omp parallel for num_threads(m_threads) schedule(dynamic, 4)
-    for (long q = 0; q < C; ++q) {
-        const Node& n = m_nodes[static_cast<size_t>(clusters[static_cast<size_t>(q)])];
-        thread_local std::vector<Segment> segs;
-        thread_local std::vector<uint8_t> sides;
-        thread_local std::vector<int32_t> group;
-        segs.clear();
-        sides.clear();
-        group.clear();
-        // The members child by child (the children's ranges make up the
-        // cluster's).
-        for (int g = 0; g < n.nchild; ++g) {
-            const Node& child = m_nodes[static_cast<size_t>(n.child + g)];
-            FLATRAD_ASSERT(child.cluster(), "a table cluster's children are clusters");
-            const ClusterNode& c = m_hierarchy.node(child.hnode);
-            for (int32_t k = c.first; k < c.first + c.count; ++k) {
-                const size_t s = static_cast<size_t>(m_hierarchy.order()[static_cast<size_t>(k)]);
-                const SceneSegment& ss = m_scene.segments[s];
-                uint8_t has = 0;
-                if (ss.lit_left || m_visible_sink[2 * s]) has |= left_side;
-                if (ss.lit_right || m_visible_sink[2 * s + 1]) has |= right_side;
-                if (m_hierarchy.can_block(static_cast<int>(s))) has |= blocks;
-                segs.push_back(ss.seg);
-                sides.push_back(has);
-                group.push_back(g);
-            }
+    // Every cluster at once, by merged front envelopes (solver/front_envelopes.h),
+    // each with its children as the groups: their slots' order.
+    std::vector<uint8_t> sides_at(m_hierarchy.order().size());
+    for (size_t q = 0; q < sides_at.size(); ++q) {
+        const size_t s = static_cast<size_t>(m_hierarchy.order()[q]);
+        const SceneSegment& ss = m_scene.segments[s];
+        uint8_t has = 0;
+        if (ss.lit_left || m_visible_sink[2 * s]) has |= left_side;
+        if (ss.lit_right || m_visible_sink[2 * s + 1]) has |= right_side;
+        if (m_hierarchy.can_block(static_cast<int>(s))) has |= blocks;
+        sides_at[q] = has;
+    }
+    EnvelopeClusters asked;
+    asked.group_begin.push_back(0);
+    for (int k : clusters) {
+        const Node& n = m_nodes[static_cast<size_t>(k)];
+        asked.node.push_back(n.hnode);
+        for (int ch = n.child; ch < n.child + n.nchild; ++ch) {
+            FLATRAD_ASSERT(m_nodes[static_cast<size_t>(ch)].cluster(), "a table cluster's children are clusters");
+            asked.group_node.push_back(m_nodes[static_cast<size_t>(ch)].hnode);
         }
-        FLATRAD_ASSERT(static_cast<int32_t>(segs.size()) == m_hierarchy.node(n.hnode).count,
-                       "a cluster's children hold its members");
-        double front[K];
-        visible_fraction(segs.data(), sides.data(), segs.size(), &A[static_cast<size_t>(n.table) * K], group.data(),
-                         n.nchild, &seen[static_cast<size_t>(slot[static_cast<size_t>(n.child)]) * K], 0, front);
-        const auto& dirs = bin_directions();
+        asked.group_begin.push_back(static_cast<int32_t>(asked.group_node.size()));
+    }
+    EnvelopeShares shares = cluster_visible_fractions(m_hierarchy, sides_at, asked, m_threads);
+    std::vector<double> A(static_cast<size_t>(m_tables_count) * K, 1.0);
+    std::vector<double> seen = std::move(shares.group);  // per child: its lobes' share seen from outside its parent
+    FLATRAD_ASSERT(seen.size() == static_cast<size_t>(slots) * K, "one group per slot");
+    std::vector<double> face(static_cast<size_t>(m_tables_count) * K, 0.0);
+    const auto& dirs = bin_directions();
+    for (size_t q = 0; q < clusters.size(); ++q) {
+        const Node& n = m_nodes[static_cast<size_t>(clusters[q])];
         for (int b = 0; b < K; ++b) {
-            const double o = front[b] - dot(n.center, dirs[static_cast<size_t>(b)]);
-            face[static_cast<size_t>(n.table) * K + static_cast<size_t>(b)] = std::isfinite(o) ? std::clamp(o, -n.radius, n.radius) : 0.0;
+            const size_t at = static_cast<size_t>(n.table) * K + static_cast<size_t>(b);
+            A[at] = shares.whole[q * K + static_cast<size_t>(b)];
+            const double o = shares.front[q * K + static_cast<size_t>(b)] - dot(n.center, dirs[static_cast<size_t>(b)]);
+            face[at] = std::isfinite(o) ? std::clamp(o, -n.radius, n.radius) : 0.0;
         }
     }
     if (std::all_of(A.begin(), A.end(), [](double a) { return a == 1.0; })) return;

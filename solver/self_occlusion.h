@@ -13,7 +13,10 @@
 /// without it a cluster link gives every hidden member its full share, and
 /// the solution absorbs more than is emitted.
 ///
-/// visible_fraction() measures, per direction bin, the share of the lobe
+/// visible_fraction() measures, for one set of segments (the hierarchical
+/// solver measures all its clusters at once, exactly, by merged front
+/// envelopes: solver/front_envelopes.h, tested against this), per
+/// direction bin, the share of the lobe
 /// sum that is seen from far along that direction: a 1D visible-surface
 /// problem (the frontmost segment per line across the cluster), solved on
 /// a grid of lines across the set's extent, as a depth buffer. Seen from a
