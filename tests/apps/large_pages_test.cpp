@@ -21,6 +21,7 @@ namespace {
 // constructors (mimalloc's included) and before main(), so the option is
 // already on here only if .preinit_array set it, ahead of all of them.
 const bool on_before_main = mi_option_is_enabled(mi_option_large_os_pages);
+const long delay_before_main = mi_option_get(mi_option_eager_commit_delay);
 }  // namespace
 
 TEST_CASE("the environment's setting of large pages is found in envp") {
@@ -33,6 +34,14 @@ TEST_CASE("the environment's setting of large pages is found in envp") {
     CHECK(flatrad::large_pages_set_by_environment(upper));
     CHECK(flatrad::large_pages_set_by_environment(lower));
     CHECK_FALSE(flatrad::large_pages_set_by_environment(nullptr));
+    char f[] = "MIMALLOC_EAGER_COMMIT_DELAY=2", g[] = "mimalloc_eager_commit_delay=1", h[] = "MIMALLOC_EAGER_COMMIT=1";
+    char* delay_upper[] = {a, f, nullptr};
+    char* delay_lower[] = {g, nullptr};
+    char* other[] = {h, b, nullptr};
+    CHECK(flatrad::option_set_by_environment(delay_upper, "MIMALLOC_EAGER_COMMIT_DELAY"));
+    CHECK(flatrad::option_set_by_environment(delay_lower, "MIMALLOC_EAGER_COMMIT_DELAY"));
+    CHECK_FALSE(flatrad::option_set_by_environment(other, "MIMALLOC_EAGER_COMMIT_DELAY"));
+    CHECK_FALSE(flatrad::option_set_by_environment(upper, "MIMALLOC_EAGER_COMMIT_DELAY"));
 }
 
 TEST_CASE("the programs' operator new and malloc are mimalloc's, with large OS pages from before main") {
@@ -40,6 +49,9 @@ TEST_CASE("the programs' operator new and malloc are mimalloc's, with large OS p
     if (!env) env = std::getenv("mimalloc_large_os_pages");
 #if defined(__ELF__) && defined(__linux__)
     if (!env) CHECK(on_before_main);
+    // Every thread's first segment committed at once, in large pages.
+    if (!std::getenv("MIMALLOC_EAGER_COMMIT_DELAY") && !std::getenv("mimalloc_eager_commit_delay"))
+        CHECK(delay_before_main == 0);
 #endif
     flatrad::use_large_pages_in_main();
     if (!env) CHECK(mi_option_is_enabled(mi_option_large_os_pages));
