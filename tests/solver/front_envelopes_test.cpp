@@ -12,6 +12,7 @@
 #include "engine/hierarchy.h"
 #include "solver/front_envelopes.h"
 #include "solver/self_occlusion.h"
+#include "support/seen_oracle.h"
 
 using namespace flatrad;
 
@@ -23,13 +24,7 @@ constexpr int K = directional_bins;
 // another order than the oracle's: they agree to rounding, far inside this.
 constexpr double rounding_tolerance = 1e-9;
 
-// Whether segments p and q cross or touch (orientation tests).
-bool meet(const Segment& p, const Segment& q) {
-    auto side = [](Vec2 a, Vec2 b, Vec2 c) { return cross(b - a, c - a); };
-    const double d1 = side(q.a, q.b, p.a), d2 = side(q.a, q.b, p.b);
-    const double d3 = side(p.a, p.b, q.a), d4 = side(p.a, p.b, q.b);
-    return (d1 * d2 <= 0) && (d3 * d4 <= 0);
-}
+using test::meet;
 
 // n random sticks in the unit square, none meeting another.
 std::vector<Segment> sticks(size_t n, double length, std::mt19937& rng) {
@@ -41,62 +36,6 @@ std::vector<Segment> sticks(size_t n, double length, std::mt19937& rng) {
         const Vec2 d{0.5 * length * std::cos(a), 0.5 * length * std::sin(a)};
         const Segment s{c - d, c + d};
         if (std::none_of(out.begin(), out.end(), [&](const Segment& t) { return meet(s, t); })) out.push_back(s);
-    }
-    return out;
-}
-
-// The slow obvious version, exactly, for segments that do not cross: per
-// facing side, its interval across u minus the overlaps with blockers in
-// front of it (which one is in front is the same all over an overlap, so
-// its midpoint decides); the seen width per segment and the integral of
-// its depth dot(x, u) over its seen runs.
-struct OracleSegment {
-    double facing_width = 0, seen = 0, depth_integral = 0;
-};
-
-std::vector<OracleSegment> oracle(const std::vector<Segment>& segs, const std::vector<uint8_t>& sides, Vec2 u) {
-    const Vec2 v{-u.y, u.x};
-    struct Proj {
-        double lo, hi, dlo, dhi;
-    };
-    std::vector<Proj> pr;
-    for (const Segment& s : segs) {
-        double pa = dot(s.a, v), pb = dot(s.b, v), da = dot(s.a, u), db = dot(s.b, u);
-        if (pa > pb) {
-            std::swap(pa, pb);
-            std::swap(da, db);
-        }
-        pr.push_back({pa, pb, da, db});
-    }
-    auto depth_at = [&](size_t i, double p) {
-        const Proj& q = pr[i];
-        return q.hi > q.lo ? q.dlo + (p - q.lo) / (q.hi - q.lo) * (q.dhi - q.dlo) : q.dlo;
-    };
-    std::vector<OracleSegment> out(segs.size());
-    for (size_t i = 0; i < segs.size(); ++i) {
-        const double c = dot(segs[i].left_normal(), u);
-        const uint8_t side = c > 0 ? left_side : c < 0 ? right_side : 0;
-        if (!(sides[i] & side)) continue;
-        out[i].facing_width = pr[i].hi - pr[i].lo;
-        std::vector<std::pair<double, double>> hidden;
-        for (size_t j = 0; j < segs.size(); ++j) {
-            if (j == i || !(sides[j] & blocks)) continue;
-            const double lo = std::max(pr[i].lo, pr[j].lo), hi = std::min(pr[i].hi, pr[j].hi);
-            if (hi <= lo) continue;
-            const double mid = 0.5 * (lo + hi);
-            if (depth_at(j, mid) > depth_at(i, mid)) hidden.push_back({lo, hi});
-        }
-        std::sort(hidden.begin(), hidden.end());
-        double at = pr[i].lo;
-        auto run = [&](double a, double b) {
-            out[i].seen += b - a;
-            out[i].depth_integral += (b - a) * depth_at(i, 0.5 * (a + b));
-        };
-        for (const auto& [lo, hi] : hidden) {
-            if (lo > at) run(at, lo);
-            at = std::max(at, hi);
-        }
-        if (pr[i].hi > at) run(at, pr[i].hi);
     }
     return out;
 }
@@ -143,9 +82,9 @@ void check_against_oracle(const std::vector<Segment>& segs, const std::vector<ui
             set_sides.push_back(sides[static_cast<size_t>(m)]);
         }
         for (int k = 0; k < K; ++k) {
-            const std::vector<OracleSegment> o = oracle(set, set_sides, dirs[static_cast<size_t>(k)]);
+            const std::vector<test::SeenSegment> o = test::seen_segments(set, set_sides, dirs[static_cast<size_t>(k)]);
             double seen = 0, all = 0, depth = 0;
-            for (const OracleSegment& x : o) {
+            for (const test::SeenSegment& x : o) {
                 seen += x.seen;
                 all += x.facing_width;
                 depth += x.depth_integral;

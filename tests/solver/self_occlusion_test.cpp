@@ -14,6 +14,7 @@
 #include "solver/exact_solver.h"
 #include "solver/hierarchical_solver.h"
 #include "solver/self_occlusion.h"
+#include "support/seen_oracle.h"
 
 using namespace flatrad;
 
@@ -26,74 +27,7 @@ int bin_at(double angle) {
     return static_cast<int>(std::lround(angle / (2 * std::numbers::pi / directional_bins))) % directional_bins;
 }
 
-// Whether segments p and q cross or touch (orientation tests).
-bool meet(const Segment& p, const Segment& q) {
-    auto side = [](Vec2 a, Vec2 b, Vec2 c) { return cross(b - a, c - a); };
-    const double d1 = side(q.a, q.b, p.a), d2 = side(q.a, q.b, p.b);
-    const double d3 = side(p.a, p.b, q.a), d4 = side(p.a, p.b, q.b);
-    return (d1 * d2 <= 0) && (d3 * d4 <= 0);
-}
-
-// The slow obvious version, exactly: per facing side, its projected interval
-// minus the overlaps with blockers in front of it (non-crossing segments:
-// which one is in front is the same all over an overlap, so its midpoint
-// decides). Returns the fraction and counts the visible runs.
-struct Exact {
-    double fraction = 1;
-    double facing_width = 0;  // sum of the facing sides' projected widths
-    int runs = 0;             // disjoint visible pieces
-};
-
-Exact exact_fraction(const std::vector<Segment>& segs, const std::vector<uint8_t>& sides, Vec2 u) {
-    const Vec2 v{-u.y, u.x};
-    struct Proj {
-        double lo, hi, dlo, dhi;
-    };
-    std::vector<Proj> pr;
-    for (const Segment& s : segs) {
-        double pa = dot(s.a, v), pb = dot(s.b, v), da = dot(s.a, u), db = dot(s.b, u);
-        if (pa > pb) {
-            std::swap(pa, pb);
-            std::swap(da, db);
-        }
-        pr.push_back({pa, pb, da, db});
-    }
-    auto depth_at = [&](size_t i, double p) {
-        const Proj& q = pr[i];
-        return q.hi > q.lo ? q.dlo + (p - q.lo) / (q.hi - q.lo) * (q.dhi - q.dlo) : q.dlo;
-    };
-    Exact e;
-    double seen = 0;
-    for (size_t i = 0; i < segs.size(); ++i) {
-        const double c = dot(segs[i].left_normal(), u);
-        const uint8_t side = c > 0 ? left_side : c < 0 ? right_side : 0;
-        if (!(sides[i] & side)) continue;
-        e.facing_width += pr[i].hi - pr[i].lo;
-        std::vector<std::pair<double, double>> hidden;
-        for (size_t j = 0; j < segs.size(); ++j) {
-            if (j == i || !(sides[j] & blocks)) continue;
-            const double lo = std::max(pr[i].lo, pr[j].lo), hi = std::min(pr[i].hi, pr[j].hi);
-            if (hi <= lo) continue;
-            const double mid = 0.5 * (lo + hi);
-            if (depth_at(j, mid) > depth_at(i, mid)) hidden.push_back({lo, hi});
-        }
-        std::sort(hidden.begin(), hidden.end());
-        double at = pr[i].lo;
-        for (const auto& [lo, hi] : hidden) {
-            if (lo > at) {
-                seen += lo - at;
-                ++e.runs;
-            }
-            at = std::max(at, hi);
-        }
-        if (pr[i].hi > at) {
-            seen += pr[i].hi - at;
-            ++e.runs;
-        }
-    }
-    if (e.facing_width > 0) e.fraction = seen / e.facing_width;
-    return e;
-}
+using test::meet;
 
 }  // namespace
 
@@ -198,7 +132,7 @@ TEST_CASE("visible fraction: random non-crossing sticks against the exact interv
         visible_fraction(segs.data(), sides.data(), segs.size(), auto_f);  // exact up to exact_up_to segments
         for (int k = 0; k < directional_bins; ++k) {
             const Vec2 u = dirs[static_cast<size_t>(k)];
-            const Exact e = exact_fraction(segs, sides, u);
+            const test::SeenShare e = test::seen_share(segs, sides, u);
             if (e.facing_width <= 0) continue;
             // The lines' spacing over the set's extent across u.
             const Vec2 v{-u.y, u.x};
