@@ -14,9 +14,9 @@
 // before main(); an option set in main() reaches only the segments mapped
 // after. A solve that fits in that first segment (the 1000-segment forest
 // of `flatrad_bench versus`: 17 MB) then takes its pages 4 KiB at a time:
-// 2968 page faults for one `flatrad solve` at eps 12 against 785 with the
-// option set from the start, and 80.7 ms against 65.6 ms (medians of 15,
-// alternating; page faults cost ~5 us each on this virtual machine). So on
+// 2968 page faults for one `flatrad solve` at eps 12 against 688 with the
+// option set as below, and 81.6 ms against 71.3 ms (medians of 15,
+// alternating; page faults cost ~5-10 us each on this virtual machine). So on
 // ELF systems the option is set from .preinit_array, which the dynamic
 // loader runs after relocation and before any library's constructor,
 // mimalloc's included, so before the first allocation; elsewhere, first

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <span>
 #include <utility>
 
 #include "engine/error.h"
@@ -54,7 +55,7 @@ void emit(Envelope& out, double x0, double x1, int32_t at) {
 // on [lo, hi], the one in front at both ends takes it; if they change
 // places (crossing segments), the interval is split where their depths
 // are equal.
-void merge(const Envelope& a, const Envelope& b, double sign, const Projected& pr, Envelope& out) {
+void merge(std::span<const Piece> a, std::span<const Piece> b, double sign, const Projected& pr, Envelope& out) {
     out.clear();
     size_t i = 0, j = 0;
     double done = -std::numeric_limits<double>::infinity();  // everything left of it is in `out`
@@ -100,15 +101,6 @@ void merge(const Envelope& a, const Envelope& b, double sign, const Projected& p
     for (; i < a.size(); ++i) emit(out, std::max(a[i].x0, done), a[i].x1, a[i].at);
     for (; j < b.size(); ++j) emit(out, std::max(b[j].x0, done), b[j].x1, b[j].at);
 }
-
-// What one cluster sees along one way (w = 0: along u with its front
-// envelope; 1: along -u with its back envelope): per group, the seen width
-// of its facing sides, and their summed depth (along the way's direction)
-// times width.
-struct Seen {
-    std::vector<double> width;  // per group of the cluster
-    double depth_sum = 0;
-};
 
 // Segment q (not a blocker) against envelope e (sign as in merge): the
 // width of [lo, hi] where it lies in front of e or e is empty, and the
@@ -216,7 +208,7 @@ private:
                 for (int w = 0; w < 2; ++w)
                     if (m_pr.faces[s] & (1 << w)) m_all[static_cast<size_t>(w)][static_cast<size_t>(node)] += m_pr.hi[s] - m_pr.lo[s];
                 if (!(m_sides[s] & blocks) || !(m_pr.hi[s] > m_pr.lo[s])) continue;
-                const Envelope one{{m_pr.lo[s], m_pr.hi[s], q}};
+                const Piece one[1] = {{m_pr.lo[s], m_pr.hi[s], q}};
                 merge(L.front, one, 1.0, m_pr, L.scratch);
                 std::swap(L.front, L.scratch);
                 merge(L.back, one, -1.0, m_pr, L.scratch);
