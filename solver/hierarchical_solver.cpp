@@ -1080,7 +1080,7 @@ void HierarchicalSolver::build_tree() {
 // against 6.2 ms on two, the same error against exact), so that its
 // sensitivity is A x the lobes' sum;
 // and, per child, the share of that child's lobes seen from outside the
-// cluster (the same depth buffer, by groups). The operator applies it edge
+// cluster (the same envelopes, by groups). The operator applies it edge
 // by edge: a child's gamma is its share seen from outside its parent over
 // its share seen from outside itself (what its own table already counts),
 // and it scales the exitance the child pulls up into its parent's table

@@ -75,10 +75,10 @@ constexpr int initial_bins = direction_bounds_initial_bins;
 // (gaps_in_window): a bin's shadows in a dense forest cover its window in
 // a few, where a sort compares each ~log2(n) times, with branches it
 // mispredicts. The 1000-segment forest of `scripts/bench versus` at eps
-// 12, in-process medians of 9 runs, 5-7 rounds alternating: 86.1 ->
-// 81.3 ms on one thread, 55.5 -> 54.9 ms on two, with 1.2% more
-// instructions (callgrind) than with std::sort and a sweep; the answers
-// within rounding (1e-14 relative).
+// 12, in-process medians of 9 runs, 15 rounds alternating: 87-91 ms
+// against 91-93 ms on one thread (the rounds the machine did not slow),
+// ~1% on two, with 1.2% more instructions (callgrind) than with std::sort
+// and a sweep; the answers within rounding (1e-14 relative).
 double free_length(Interval w, std::vector<Interval>& shadows) {
     if (!(w.b > w.a)) return 0;  // (also not finite)
     return gaps_in_window(w, shadows.data(), shadows.size(), std::numeric_limits<double>::infinity());
