@@ -174,12 +174,8 @@ public:
             pr.hi[q] = pb;
             pr.dlo[q] = span > 0 ? da : 0.5 * (da + db);
             pr.slope[q] = span > 0 ? (db - da) / span : 0.0;
-            // As facing_ways (self_occlusion.cpp): the side whose normal is
-            // along u faces a viewer far along u.
-            const double c = dot(s.left_normal(), u);
-            const uint8_t along = c > 0 ? left_side : c < 0 ? right_side : 0;
-            const uint8_t against = c > 0 ? right_side : c < 0 ? left_side : 0;
-            pr.faces[q] = static_cast<uint8_t>(((m_sides[q] & along) ? 1 : 0) | ((m_sides[q] & against) ? 2 : 0));
+            const Facing f = facing_ways(s, m_sides[q], u);
+            pr.faces[q] = static_cast<uint8_t>((f.way[0] ? 1 : 0) | (f.way[1] ? 2 : 0));
         }
         if (!finite) return;  // unmeasured (the outputs keep their 1 and NaN)
         const size_t H = m_h.nodes().size();

@@ -11,19 +11,6 @@ namespace flatrad {
 
 namespace {
 
-// Which of segment s's existing sides (`has`, self_occlusion.h's bits)
-// face u and -u: [0] along u, [1] along -u (a segment along u faces
-// neither).
-struct Facing {
-    bool way[2];
-};
-Facing facing_ways(const Segment& s, uint8_t has, Vec2 u) {
-    const double c = dot(s.left_normal(), u);
-    const uint8_t along = c > 0 ? left_side : c < 0 ? right_side : 0;
-    const uint8_t against = c > 0 ? right_side : c < 0 ? left_side : 0;
-    return {{(has & along) != 0, (has & against) != 0}};
-}
-
 // Exactly, for few segments: per facing side, its interval across u minus
 // the overlaps with blockers in front of it (segments that do not cross:
 // which of two is in front is the same all over their overlap, so its

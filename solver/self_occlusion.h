@@ -36,6 +36,19 @@ namespace flatrad {
 /// a wall on the scene's hull stands between nothing, and hides nothing).
 inline constexpr uint8_t left_side = 1, right_side = 2, blocks = 4;
 
+/// Which of segment s's existing sides (`has`, the bits above) face u and
+/// -u, seen from far along each: way[0] along u (the side whose normal is
+/// along u), way[1] along -u (a segment along u faces neither).
+struct Facing {
+    bool way[2];
+};
+inline Facing facing_ways(const Segment& s, uint8_t has, Vec2 u) {
+    const double c = dot(s.left_normal(), u);
+    const uint8_t along = c > 0 ? left_side : c < 0 ? right_side : 0;
+    const uint8_t against = c > 0 ? right_side : c < 0 ? left_side : 0;
+    return {{(has & along) != 0, (has & against) != 0}};
+}
+
 /// Up to this many segments visible_fraction is exact (see there).
 inline constexpr size_t exact_up_to = 24;
 
