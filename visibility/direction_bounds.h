@@ -67,7 +67,6 @@ struct DirectionBoundsScratch {
     std::vector<double> radius;
     using Interval = OffsetInterval;
     std::vector<Interval> intervals, narrow_intervals;
-    std::vector<double> projections;
     struct Bin {
         double c, h, lower, upper;
     };
