@@ -359,6 +359,9 @@ struct Link {
     // Element links: kvar is kernel_variation itself, or (false) its bound
     // 2 Fu, until a decision needs the exact value (refine).
     bool kvar_exact = true;
+    // Made by a split (children_links, self_links), its geometry not
+    // computed yet: the next wave's decision computes it (make_link) first.
+    bool fresh = false;
     double coef = 0;
     float tau = 1;            // transmittance (cluster links), F / F_unoccluded (element links)
     float vis_err = 0;        // visibility bound: on tau (cluster links) or on F (element links)
@@ -653,7 +656,6 @@ private:
     bool behind_closure_screen(int e, const Box& region, ExactWorkspace& ws, VisibilityStats& st) const;
     bool shown_closed_whole(const Link& l, ExactWorkspace& ws, VisibilityStats& st) const;
     Box cluster_target_region(int hnode, Vec2 from) const;
-    void compute_links(LinkVector& links);
     int split_element(int node);
     void pull_tables(const double* leaf_value, std::vector<double>& Bn, TableArray& I,
                      const Part* part = nullptr) const;
@@ -1385,13 +1387,17 @@ void HierarchicalSolver::self_links(int node, LinkVector& out) const {
             const Node& na = m_nodes[static_cast<size_t>(a)];
             const Node& nb = m_nodes[static_cast<size_t>(b)];
             if (a == b) {
-                if (na.cluster()) out.push_back(link_between(a, a));
+                if (na.cluster()) {
+                    out.push_back(link_between(a, a));
+                    out.back().fresh = true;
+                }
                 continue;
             }
             if (!nb.can_send || (!na.cluster() && !nb.cluster() && na.segment == nb.segment)) continue;
             Link l;
             l.r = a;
             l.s = b;
+            l.fresh = true;
             out.push_back(l);
         }
 }
@@ -1412,6 +1418,7 @@ void HierarchicalSolver::children_links(const Link& l, bool split_r, LinkVector&
         if (!nr.cluster() && !ns.cluster() && nr.segment == ns.segment) continue;
         // Halves of an element link lie in its shaft: an empty shaft stays empty.
         k.clear = l.clear && !nr.cluster() && !ns.cluster();
+        k.fresh = true;
         out.push_back(k);
     }
 }
@@ -1950,31 +1957,6 @@ bool HierarchicalSolver::shown_closed_whole(const Link& l, ExactWorkspace& ws, V
     return m_vis.box_shown_closed(e.seg, skip(e.hnode), c.hnode, skip(c.hnode), ws, st);
 }
 
-void HierarchicalSolver::compute_links(LinkVector& links) {
-    const auto t0 = Clock::now();
-    const long n = static_cast<long>(links.size());
-    std::vector<char> keep(links.size(), 1);
-    // Geometry only (visibility is asked in refine's decisions), ~1 us a
-    // link: small batches run on one thread, waking the team costs more
-    // than they do (and much more on a loaded machine).
-#pragma omp parallel num_threads(m_threads) if (n > 16 * parallel_min_work)
-    {
-        VisibilityStats local;
-#pragma omp for schedule(dynamic, 16)
-        for (long k = 0; k < n; ++k) {
-            Link& l = links[static_cast<size_t>(k)];
-            keep[static_cast<size_t>(k)] = make_link(l.r, l.s, l, local) ? 1 : 0;
-        }
-#pragma omp critical
-        m_stats += local;
-    }
-    size_t w = 0;
-    for (size_t k = 0; k < links.size(); ++k)
-        if (keep[k]) links[w++] = links[k];
-    links.resize(w);
-    m_ff_time += seconds_since(t0);
-}
-
 // Creates the two halves of element `node` if it has none; returns the first.
 int HierarchicalSolver::split_element(int node) {
     if (m_nodes[static_cast<size_t>(node)].child >= 0) return m_nodes[static_cast<size_t>(node)].child;
@@ -2382,14 +2364,14 @@ bool HierarchicalSolver::refine(const std::vector<double>& leaf_bmax, double exi
         const long nw = static_cast<long>(m_links.size() - tail);
         decision.assign(static_cast<size_t>(nw), 0);
         const auto t_decide = Clock::now();
-        long resolved = 0;
+        long resolved = 0, computed = 0;
         ++m_wave;  // (link_transmittance: answers of this wave are not shortcuts within it)
         m_pair_kept.resize(m_nodes.size(), 0);  // (element_exchange: the nodes split since)
 #pragma omp parallel num_threads(m_threads) if (nw > parallel_min_work)
         {
             ExactWorkspace ws;
             VisibilityStats local;
-            long asked = 0;
+            long asked = 0, made = 0;
             bool above = false;
             // Small chunks: a wave's queries cluster (the children of one
             // split link sit side by side, often all in one crowded shaft),
@@ -2403,6 +2385,18 @@ bool HierarchicalSolver::refine(const std::vector<double>& leaf_bmax, double exi
                 Link& l = m_links[tail + static_cast<size_t>(k)];
                 const Node& r = m_nodes[static_cast<size_t>(l.r)];
                 const Node& s = m_nodes[static_cast<size_t>(l.s)];
+                // A link made by the last wave's splits: its geometry first
+                // (~1 us; here rather than in a pass of its own between the
+                // waves, so that it runs on the team with the decisions,
+                // where most waves were too small to be worth waking it).
+                if (l.fresh) {
+                    l.fresh = false;
+                    ++made;
+                    if (!make_link(l.r, l.s, l, local)) {
+                        decision[static_cast<size_t>(k)] = 4;  // cannot exchange: dropped
+                        continue;
+                    }
+                }
                 if (l.r == l.s && !l.uniform) {
                     decision[static_cast<size_t>(k)] = 3;
                     continue;
@@ -2467,13 +2461,14 @@ bool HierarchicalSolver::refine(const std::vector<double>& leaf_bmax, double exi
             {
                 m_stats += local;
                 resolved += asked;
+                computed += made;
                 exceeded = exceeded || above;
             }
         }
-        if (resolved > 0) {
-            m_ff_time += seconds_since(t_decide);
-            m_operator_changed = true;  // (a queried link's coefficient is new)
-        }
+        // (The form factors' time: the waves that computed coefficients,
+        // geometry or visibility.)
+        if (resolved > 0 || computed > 0) m_ff_time += seconds_since(t_decide);
+        if (resolved > 0) m_operator_changed = true;  // (a queried link's coefficient is new)
         // The first wave holds every link: if none exceeds eps_abs, the
         // round splits nothing (links that nothing passes are still dropped).
         if (first_wave && !exceeded)
@@ -2515,8 +2510,8 @@ bool HierarchicalSolver::refine(const std::vector<double>& leaf_bmax, double exi
         first_wave = false;
         m_links.resize(w);
         tail = w;
-        // 3. Coefficients of the new links (in parallel), then append them.
-        compute_links(fresh);
+        // 3. The new links, to be decided by the next wave (which computes
+        // their geometry first: Link::fresh).
         m_links.insert(m_links.end(), fresh.begin(), fresh.end());
         if (!fresh.empty()) progress(fmt::format("refining: {} links", m_links.size()), -1);
     }
