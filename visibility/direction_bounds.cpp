@@ -68,8 +68,9 @@ using Bin = DirectionBoundsScratch::Bin;
 // 0.60 / 2.05 s at relative L2 1.8e-2 / 1.0e-2 / 2.2e-3; 16 bins 0.43 /
 // 0.63 / 2.04 s at 9.5e-3 / 6.0e-3 / 1.8e-3 (the same errors as exact
 // visibility at half the eps); 32 bins 0.53 / 0.74 / 2.26 s at 8.8e-3 /
-// 5.5e-3 / 1.8e-3; 4 bins 2.0e-2 at eps 1.
-constexpr int initial_bins = direction_bounds_initial_bins;
+// 5.5e-3 / 1.8e-3; 4 bins 2.0e-2 at eps 1. (Those were tight queries,
+// where bins are halved anyway; loose ones, DirectionBoundsOptions, start
+// from fewer.)
 
 // Length of w left by the first m `shadows` (reordered). By hops first
 // (gaps_in_window): a bin's shadows in a dense forest cover its window in
@@ -89,6 +90,8 @@ struct Evaluator {
     const std::vector<double>& radius;  // |P| of each
     std::vector<Interval>& wide_shadows;
     std::vector<Interval>& narrow_shadows;
+    std::vector<Interval>& centre_shadows;
+    bool estimate;  // also the free length at c itself (bin.centre)
 
     // lower and upper bounds of free(phi) over [c - h, c + h].
     void operator()(Bin& bin) const {
@@ -104,6 +107,14 @@ struct Evaluator {
         const Interval ai = wide(0), aj = wide(2), ni = narrow(0), nj = narrow(2);
         const Interval window_wide{std::max(ai.a, aj.a), std::min(ai.b, aj.b)};
         const Interval window_narrow{std::max(ni.a, nj.a), std::min(ni.b, nj.b)};
+        // At the bin's centre direction itself (no drift): the midpoint
+        // rule's sample (DirectionBounds::estimate).
+        auto at_centre = [&](size_t k) {
+            const double p = proj(k), q = proj(k + 1);
+            return Interval{std::min(p, q), std::max(p, q)};
+        };
+        const Interval ci = at_centre(0), cj = at_centre(2);
+        const Interval window_centre{std::max(ci.a, cj.a), std::min(ci.b, cj.b)};
         // Fewest free lines: the narrow window, wide shadows; most: the
         // wide window, narrow shadows. Each piece's two shadows are written
         // in place and kept by advancing the count (no branch on whether
@@ -116,9 +127,11 @@ struct Evaluator {
         const size_t pieces = n > 4 ? (n - 4) / 2 : 0;
         if (wide_shadows.size() < pieces) wide_shadows.resize(pieces);
         if (narrow_shadows.size() < pieces) narrow_shadows.resize(pieces);
+        if (centre_shadows.size() < pieces) centre_shadows.resize(pieces);
         Interval* ws = wide_shadows.data();
         Interval* ns = narrow_shadows.data();
-        size_t mw = 0, mn = 0;
+        Interval* cs = centre_shadows.data();
+        size_t mw = 0, mn = 0, mc = 0;
         for (size_t k = 4; k + 1 < n; k += 2) {
             const double p = proj(k), q = proj(k + 1), dp = R[k] * h, dq = R[k + 1] * h;
             const Interval sw = swept(p, dp, q, dq), sn = held(p, dp, q, dq);
@@ -126,7 +139,11 @@ struct Evaluator {
             mw += sw.b > window_narrow.a && sw.a < window_narrow.b;
             ns[mn] = sn;
             mn += sn.b > sn.a && sn.b > window_wide.a && sn.a < window_wide.b;
+            const Interval sc{std::min(p, q), std::max(p, q)};
+            cs[mc] = sc;
+            mc += estimate && sc.b > window_centre.a && sc.a < window_centre.b;
         }
+        bin.centre = estimate ? free_length(window_centre, cs, mc) : 0.0;
         bin.lower = free_length(window_narrow, ws, mw);
         bin.upper = free_length(window_wide, ns, mn);
         bin.lower = std::min(bin.lower, bin.upper);
@@ -139,7 +156,8 @@ bool smaller_gap(const Bin& x, const Bin& y) { return x.h * (x.upper - x.lower) 
 }  // namespace
 
 DirectionBounds direction_bounds(const Segment& ci, const Segment& cj, const Segment* pieces, size_t count,
-                                 double tol, long max_evaluations, DirectionBoundsScratch& ws) {
+                                 double tol, long max_evaluations, DirectionBoundsScratch& ws,
+                                 const DirectionBoundsOptions& how) {
     DirectionBounds out;
     const shaft_detail::PairFrame frame(ci, cj);
     auto& pts = ws.points;
@@ -167,7 +185,7 @@ DirectionBounds direction_bounds(const Segment& ci, const Segment& cj, const Seg
         radius[k] = norm(pts[k]);
     }
 
-    const Evaluator eval{pts, radius, ws.intervals, ws.narrow_intervals};
+    const Evaluator eval{pts, radius, ws.intervals, ws.narrow_intervals, ws.centre_intervals, how.estimate};
     auto& bins = ws.bins;
     bins.clear();
     double lo = 0, hi = 0;  // running sums: they only steer the refinement
@@ -179,25 +197,28 @@ DirectionBounds direction_bounds(const Segment& ci, const Segment& cj, const Seg
         bins.push_back(bin);
         std::push_heap(bins.begin(), bins.end(), smaller_gap);
     };
+    const int initial_bins = std::max(1, how.initial_bins);
     const double h0 = (phi_hi - phi_lo) / (2 * initial_bins);
-    for (int b = 0; b < initial_bins; ++b) add({phi_lo + (2 * b + 1) * h0, h0, 0, 0});
+    for (int b = 0; b < initial_bins; ++b) add({phi_lo + (2 * b + 1) * h0, h0, 0, 0, 0});
     while (hi - lo > 2 * tol && out.evaluations + 2 <= max_evaluations) {
         std::pop_heap(bins.begin(), bins.end(), smaller_gap);
         const Bin worst = bins.back();
         bins.pop_back();
         lo -= worst.h * worst.lower;
         hi -= worst.h * worst.upper;
-        add({worst.c - 0.5 * worst.h, 0.5 * worst.h, 0, 0});
-        add({worst.c + 0.5 * worst.h, 0.5 * worst.h, 0, 0});
+        add({worst.c - 0.5 * worst.h, 0.5 * worst.h, 0, 0, 0});
+        add({worst.c + 0.5 * worst.h, 0.5 * worst.h, 0, 0, 0});
     }
     // The sums again, compensated, from the bins themselves.
-    CompensatedSum l, u;
+    CompensatedSum l, u, m;
     for (const Bin& b : bins) {
         l.add(b.h * b.lower);
         u.add(b.h * b.upper);
+        m.add(b.h * b.centre);
     }
     out.lo = std::max(0.0, l.value());
     out.hi = std::max(out.lo, u.value());
+    if (how.estimate) out.estimate = std::clamp(m.value(), out.lo, out.hi);
     out.converged = out.hi - out.lo <= 2 * tol;
     return out;
 }

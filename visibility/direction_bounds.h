@@ -23,6 +23,7 @@
 /// in it), so few bins. Neither samples: the bounds hold, up to rounding.
 #include <algorithm>
 #include <cstddef>
+#include <limits>
 #include <vector>
 
 #include "engine/geometry.h"
@@ -31,6 +32,13 @@ namespace flatrad {
 
 struct DirectionBounds {
     double lo = 0, hi = 0;  ///< bounds on L_i F_ij (lo <= hi)
+    /// With DirectionBoundsOptions::estimate: the midpoint rule over the
+    /// final bins (each bin's free length at its centre direction, without
+    /// drift), clamped to [lo, hi]; else NaN. An estimate, not a bound: it
+    /// tends to the integral as the bins narrow, while the bounds' midpoint
+    /// stays halfway up their gap, which through a dense forest is a bias
+    /// (the drift takes the lower bound to 0 where the truth is near it).
+    double estimate = std::numeric_limits<double>::quiet_NaN();
     long evaluations = 0;   ///< bins evaluated
     bool converged = false; ///< hi - lo <= 2 tol reached within the budget
 };
@@ -66,21 +74,28 @@ struct DirectionBoundsScratch {
     std::vector<Vec2> points;
     std::vector<double> radius;
     using Interval = OffsetInterval;
-    std::vector<Interval> intervals, narrow_intervals;
+    std::vector<Interval> intervals, narrow_intervals, centre_intervals;
     struct Bin {
-        double c, h, lower, upper;
+        double c, h, lower, upper, centre;
     };
     std::vector<Bin> bins;
 };
 
-/// Bins every call starts with (equal, over the whole range of directions).
+/// Bins a call starts with by default (equal, over the whole range of
+/// directions).
 inline constexpr int direction_bounds_initial_bins = 16;
+
+struct DirectionBoundsOptions {
+    int initial_bins = direction_bounds_initial_bins;
+    bool estimate = false;  ///< also DirectionBounds::estimate (a third sweep per bin)
+};
 
 /// Bounds on L_i F_ij for a mutually clipped facing pair (ci, cj), lit on the
 /// left, with `count` blocker pieces inside its shaft, refined until
 /// hi - lo <= 2 tol or `max_evaluations` bins have been evaluated (at least
 /// the initial ones).
 DirectionBounds direction_bounds(const Segment& ci, const Segment& cj, const Segment* pieces, size_t count,
-                                 double tol, long max_evaluations, DirectionBoundsScratch& scratch);
+                                 double tol, long max_evaluations, DirectionBoundsScratch& scratch,
+                                 const DirectionBoundsOptions& how = {});
 
 }  // namespace flatrad

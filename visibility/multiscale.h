@@ -22,13 +22,17 @@
 /// slabs around the bands' depths are walked for that, the rest only if
 /// they do not settle the query); then, where enabled
 /// (set_min_pieces_to_bound; the hierarchical solver does both, from 32
-/// pieces), a shaft crowded with blocker pieces is tried with guaranteed
+/// pieces, and bounds loose queries from 8), a shaft crowded with blocker
+/// pieces is tried with guaranteed
 /// bounds by direction bins
 /// (direction_bounds.h): the pieces' shadows widened and narrowed by how
 /// far they can move within a bin, bins halved worst first. If the bounds
 /// close to within 2 eps within a budget of bins (2 per piece), their
 /// midpoint is the answer and their half-gap the claimed bound
-/// (stats.bounded); otherwise the walk goes on as above. The exact integral
+/// (stats.bounded); otherwise the walk goes on as above. A loose query (a
+/// tolerance of at least loose_tolerance of the pair's unoccluded exchange)
+/// starts from fewer bins and also gets their midpoint rule
+/// (MultiscaleResult::estimate). The exact integral
 /// of n pieces meets ~n^2 critical directions; a bin costs two sorts of n
 /// shadows, and a dense forest covers most of the window, so few bins are
 /// needed.
@@ -81,6 +85,10 @@ struct ClusterCriteria {
 struct MultiscaleResult {
     double F = 0;               ///< F_ij
     double error_bound = 0;     ///< claimed bound on |F - F_exact|
+    /// Where the answer is bounds (error_bound > 0), an estimate of F
+    /// within them better than F itself (their midpoint), or NaN when there
+    /// is none: the direction bounds' midpoint rule (DirectionBounds::estimate).
+    double estimate = std::numeric_limits<double>::quiet_NaN();
     double quadrature_error = 0;  ///< part of the bound from the direction integral
     long clusters_visited = 0;
     long clusters_approximated = 0;
@@ -94,6 +102,7 @@ struct MultiscaleResult {
 struct TransmittanceResult {
     double tau = 0;          ///< in [0, 1]
     double error_bound = 0;  ///< claimed bound on |tau - tau_exact|
+    double estimate = std::numeric_limits<double>::quiet_NaN();  ///< as MultiscaleResult's, on tau
     long clusters_visited = 0;
     long clusters_approximated = 0;
 };
@@ -158,7 +167,12 @@ public:
     /// hierarchical solver, where the exact integral is what the bounds
     /// replace (the cluster approximation is left to shafts of 512 pieces or
     /// more), they make a 1000-segment forest 14x faster at 1% error.
-    void set_min_pieces_to_bound(size_t n) { m_min_pieces_to_bound = n; }
+    /// `loose`: the same for loose queries (above; at most n).
+    void set_min_pieces_to_bound(size_t n, size_t loose) {
+        m_min_pieces_to_bound = n;
+        m_min_pieces_to_bound_loose = std::min(n, loose);
+    }
+    void set_min_pieces_to_bound(size_t n) { set_min_pieces_to_bound(n, n); }
     /// Try bands of pieces across a shaft of at least `n` blocker pieces
     /// (opaque_band.h) before anything else: a proof that it is closed (an
     /// exact 0, stats.opaque, at any eps) or, with eps > 0, an upper bound U
@@ -234,6 +248,7 @@ private:
     std::vector<int32_t> m_position;  // segment number -> index in hierarchy order
     size_t m_min_pieces = 0;
     size_t m_min_pieces_to_bound = std::numeric_limits<size_t>::max();
+    size_t m_min_pieces_to_bound_loose = std::numeric_limits<size_t>::max();
     size_t m_min_pieces_to_prove_closed = std::numeric_limits<size_t>::max();
     double m_layers_per_depth = 0;  // the scene's layers of shadow per unit of depth (0: unknown)
 };

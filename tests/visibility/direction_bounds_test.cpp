@@ -8,6 +8,7 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 #include <tuple>
 
@@ -150,4 +151,62 @@ TEST_CASE("direction bounds: the scene scaled by 1e-6 .. 1e6: the same verdicts,
             CHECK(b.hi >= (exact - rounding_tol * unocc) * s);
         }
     }
+}
+
+TEST_CASE("direction bounds: the midpoint rule lies within the bounds and tends to the exact integral") {
+    // Without refinement (an infinite tolerance), B equal bins: the estimate
+    // (each bin's free length at its centre direction) is inside [lo, hi]
+    // at every B, NaN unless asked, and its error falls as B grows. The
+    // free length is continuous in the direction and smooth between the
+    // critical directions, so the midpoint rule's error is second order in
+    // the bins' width away from them and small in the few bins that hold
+    // one: at 4096 bins it was 5.6e-7 of the unoccluded exchange at worst
+    // on these shafts (at 8 bins 5e-3 on average, the bounds' midpoint
+    // 0.17). 1e-5 is the bar: an estimate that did not converge (a bin's
+    // sample taken at the wrong direction, or drift left in) misses it by
+    // orders of magnitude, and it leaves rounding and unlucky shafts a
+    // margin of 20.
+    constexpr double fine_bar = 1e-5;
+    std::mt19937_64 rng(17);
+    DirectionBoundsScratch scratch;
+    ExactWorkspace ws;
+    VisibilityStats st;
+    const double no_tolerance = std::numeric_limits<double>::infinity();
+    double worst_fine = 0, sum_coarse_estimate = 0, sum_coarse_midpoint = 0;
+    for (int n : {10, 40, 150}) {
+        for (double len : {0.02, 0.1, 0.4}) {
+            for (int rep = 0; rep < 6; ++rep) {
+                const Case c = random_case(rng, n, len);
+                const double unocc = exchange_crossed_strings(c.ci, c.cj);
+                const double exact = ExactVisibility::exchange_with_blockers(c.ci, c.cj, c.pieces, ws, st);
+                const DirectionBounds plain =
+                    direction_bounds(c.ci, c.cj, c.pieces.data(), c.pieces.size(), no_tolerance, 8, scratch);
+                CHECK(std::isnan(plain.estimate));
+                for (int bins : {8, 64, 512, 4096}) {
+                    DirectionBoundsOptions how;
+                    how.initial_bins = bins;
+                    how.estimate = true;
+                    const DirectionBounds b = direction_bounds(c.ci, c.cj, c.pieces.data(), c.pieces.size(),
+                                                               no_tolerance, bins, scratch, how);
+                    CAPTURE(n);
+                    CAPTURE(len);
+                    CAPTURE(bins);
+                    CHECK(b.evaluations == bins);
+                    CHECK(b.estimate >= b.lo);
+                    CHECK(b.estimate <= b.hi);
+                    if (bins == 8) {
+                        sum_coarse_estimate += std::abs(b.estimate - exact) / unocc;
+                        sum_coarse_midpoint += std::abs(0.5 * (b.lo + b.hi) - exact) / unocc;
+                    }
+                    if (bins == 4096) worst_fine = std::max(worst_fine, std::abs(b.estimate - exact) / unocc);
+                }
+            }
+        }
+    }
+    MESSAGE("worst estimate error at 4096 bins: ", worst_fine, " of the unoccluded exchange; mean at 8 bins: ",
+            sum_coarse_estimate / 54, " (the bounds' midpoint: ", sum_coarse_midpoint / 54, ")");
+    CHECK(worst_fine <= fine_bar);
+    // Why it is asked for: at 8 bins it is nearer the truth than the
+    // bounds' midpoint, on average over these shafts.
+    CHECK(sum_coarse_estimate < sum_coarse_midpoint);
 }

@@ -392,3 +392,59 @@ TEST_CASE("multiscale: below the piece threshold nothing is approximated and F i
     }
     CHECK(was_approximated > 10);  // the threshold had something to turn off
 }
+
+TEST_CASE("multiscale: a loose query is bounded from fewer pieces, with an estimate within its bound") {
+    // Sparse forests (12 to 30 sticks between the patches): below the 32
+    // pieces from which any query tries the bounds, but above the 8 from
+    // which a loose one does (set_min_pieces_to_bound(32, 8)). A loose
+    // query (tolerance the whole unoccluded F) is then answered by bounds,
+    // with their midpoint rule as its estimate: within the claimed bound of
+    // F, so within twice the bound of the truth (both lie in [F - bound, F +
+    // bound]). A tight one (1% of it) gets the exact integral, no estimate.
+    std::mt19937_64 rng(43);
+    std::uniform_real_distribution<double> U(0, 1);
+    int loose_bounded = 0, tight_exact = 0;
+    for (int t = 0; t < 40; ++t) {
+        test::Cloud c;
+        const double D = 1 + 2 * U(rng);
+        c.i = {{-0.5, 0}, {0.5, 0}};
+        c.j = {{0.5, D}, {-0.5, D}};
+        c.segments = {c.i, c.j};
+        const int n = 12 + static_cast<int>(18 * U(rng));
+        while (static_cast<int>(c.segments.size()) < n + 2) {
+            const Vec2 m{(U(rng) - 0.5) * 1.2, 0.1 + (D - 0.2) * U(rng)};
+            const double a = 2 * M_PI * U(rng), len = 0.05 + 0.1 * U(rng);
+            const Vec2 d{std::cos(a) * len / 2, std::sin(a) * len / 2};
+            c.segments.push_back({m - d, m + d});
+        }
+        test::CloudVisibility vis(c);
+        vis.multiscale.set_min_pieces_to_bound(32, 8);
+        ExactWorkspace ws;
+        VisibilityStats st;
+        const double exact = vis.exact.form_factor(c.i, c.j, 0, 1, ws, st);
+        const double unocc = form_factor_unoccluded(c.i, c.j);
+        CAPTURE(t);
+        const long before = st.bounded;
+        const MultiscaleResult loose = vis.multiscale.form_factor(c.i, c.j, 0, 1, unocc, GammaRule::Bound, ws, st);
+        if (st.bounded > before) {
+            ++loose_bounded;
+            REQUIRE_FALSE(std::isnan(loose.estimate));
+            CHECK(std::abs(loose.estimate - loose.F) <= loose.error_bound * (1 + rounding_floor));
+            CHECK(std::abs(loose.estimate - exact) <= 2 * loose.error_bound + rounding_floor * unocc);
+        } else {
+            CHECK(std::isnan(loose.estimate));
+        }
+        const long bounded_before = st.bounded;
+        const MultiscaleResult tight =
+            vis.multiscale.form_factor(c.i, c.j, 0, 1, 0.01 * unocc, GammaRule::Bound, ws, st);
+        CHECK(st.bounded == bounded_before);  // fewer than 32 pieces: never bounds
+        CHECK(std::isnan(tight.estimate));
+        if (tight.error_bound == 0) {
+            ++tight_exact;
+            CHECK(tight.F == doctest::Approx(exact).epsilon(exact_tol));
+        }
+    }
+    MESSAGE(loose_bounded << " of 40 loose queries bounded, " << tight_exact << " tight ones exact");
+    CHECK(loose_bounded >= 20);
+    CHECK(tight_exact == 40);
+}
