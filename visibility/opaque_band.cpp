@@ -64,7 +64,9 @@ double uncovered(const Band& band, int s, Vec2 n, double h, const OpaqueBandScra
         const OpaqueBandScratch::Item& e = items[it];
         const Interval sh = held(nx * e.p.x + ny * e.p.y, e.rp * h, nx * e.q.x + ny * e.q.y, e.rq * h);
         kept[m] = sh;
-        m += sh.b > sh.a && sh.b > window.a && sh.a < window.b;
+        // (& on the comparisons, not &&: no branch, which the data would
+        // make unpredictable.)
+        m += static_cast<size_t>((sh.b > sh.a) & (sh.b > window.a) & (sh.a < window.b));
     }
     // The gaps between the shadows, summed (not the window less the covered
     // length: a covered window gives exactly 0).
