@@ -453,12 +453,13 @@ struct Estimate {
     double value;
     float bound;
 };
-// (`estimate` is called only when the bound is not 0.)
-template <class EstimateFn>
-Estimate within_bound(double answer, double bound, double top, const EstimateFn& estimate) {
+// `own`: the query's estimate (NaN: none). (`prior` is called only when the
+// bound is not 0 and there is none.)
+template <class PriorFn>
+Estimate within_bound(double answer, double bound, double own, double top, const PriorFn& prior) {
     if (!(bound > 0)) return {answer, static_cast<float>(bound)};
     const double lo = std::max(0.0, answer - bound), hi = std::min(top, answer + bound);
-    const double v = std::clamp(estimate(), lo, std::max(lo, hi));
+    const double v = std::clamp(std::isnan(own) ? prior() : own, lo, std::max(lo, hi));
     const double b = std::max(v - lo, hi - v);
     float f = static_cast<float>(b);
     if (f < b) f = std::nextafter(f, std::numeric_limits<float>::infinity());
@@ -1708,9 +1709,8 @@ bool HierarchicalSolver::resolve_visibility(Link& l, ExactWorkspace& ws, Visibil
             l.coef = 0;
             return false;
         }
-        const Estimate F = within_bound(m.F, m.error_bound, Fu, [&] {
-            return std::isnan(m.estimate) ? prior_transmittance(nr, ns) * Fu : m.estimate;
-        });
+        const Estimate F =
+            within_bound(m.F, m.error_bound, m.estimate, Fu, [&] { return prior_transmittance(nr, ns) * Fu; });
         l.coef = F.value;
         l.tau = static_cast<float>(F.value / Fu);
         l.vis_err = F.bound;
@@ -1723,9 +1723,7 @@ bool HierarchicalSolver::resolve_visibility(Link& l, ExactWorkspace& ws, Visibil
         l.tau = 0;
         return false;
     }
-    const Estimate tau = within_bound(tau_answer, terr, 1.0, [&] {
-        return std::isnan(t.estimate) ? prior_transmittance(nr, ns) : t.estimate;
-    });
+    const Estimate tau = within_bound(tau_answer, terr, t.estimate, 1.0, [&] { return prior_transmittance(nr, ns); });
     l.tau = static_cast<float>(tau.value);
     l.vis_err = tau.bound;
     l.Fu = 0;

@@ -184,7 +184,7 @@ struct Evaluator {
         const size_t pieces = n > 4 ? (n - 4) / 2 : 0;
         if (wide_shadows.size() < pieces) wide_shadows.resize(pieces);
         if (narrow_shadows.size() < pieces) narrow_shadows.resize(pieces);
-        if (centre_shadows.size() < pieces) centre_shadows.resize(pieces);
+        if (estimate && centre_shadows.size() < pieces) centre_shadows.resize(pieces);
         Interval* ws = wide_shadows.data();
         Interval* ns = narrow_shadows.data();
         Interval* cs = centre_shadows.data();
@@ -196,9 +196,11 @@ struct Evaluator {
             mw += static_cast<size_t>((sw.b > window_narrow.a) & (sw.a < window_narrow.b));
             ns[mn] = sn;
             mn += static_cast<size_t>((sn.b > sn.a) & (sn.b > window_wide.a) & (sn.a < window_wide.b));
-            const Interval sc{std::min(p, q), std::max(p, q)};
-            cs[mc] = sc;
-            mc += static_cast<size_t>(estimate & (sc.b > window_centre.a) & (sc.a < window_centre.b));
+            if (estimate) {  // (the same way for every piece of a call)
+                const Interval sc{std::min(p, q), std::max(p, q)};
+                cs[mc] = sc;
+                mc += static_cast<size_t>((sc.b > window_centre.a) & (sc.a < window_centre.b));
+            }
         }
         bin.centre = estimate ? free_length(window_centre, cs, mc) : 0.0;
         bin.lower = free_length(window_narrow, ws, mw);
