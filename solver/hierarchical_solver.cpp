@@ -173,6 +173,19 @@ constexpr double closure_screen_spread = 0.04;
 // 1e-6 / 1e-10 / 1e-15 (736 / 295 / 6 links dropped whole): there the
 // proofs mostly replace closure screens' answers, which cost less.
 constexpr double box_proof_below = 1e-10;
+// Such a link whose proof leaves a gap is split on its larger end, not on
+// the end with the larger geometric error: through a dense forest that is
+// a cluster's layered term (its members hiding each other), which split
+// the receivers while a ceiling element 20-45 units long stayed whole, and
+// every cluster of about a unit across anywhere in the room ended with its
+// own link to it, each a query of a wide shaft (on the 10^6 forest at eps
+// 10, 292 000 such queries, 58 of the run's 95 thread-seconds of queries).
+// Split by size, the shafts narrow, and proofs close higher up the tree:
+// the 10^6 forest's solve 151 -> 106 s (one run each, the same hour;
+// 4.34 -> 3.21 G cluster visits), the 10^5 forest's form factors 8.4 ->
+// 4.9 s; the solutions within 2.8e-3 / 4.7e-4 relative L2 of each other;
+// the 10^4 forest 680 -> 645 ms (medians of 3, in-process, interleaved),
+// the same error against eps 1 (6.72e-3); no data scene changes.
 
 // GMRES stops at ||E - (I - rho G) B|| <= 1e-12 ||E||: the operator is
 // applied in double with sums of at most a few thousand terms per node, so
@@ -290,6 +303,9 @@ struct alignas(64) Node {
     bool cluster() const { return kind == Kind::Cluster; }
     bool sink() const { return kind == Kind::Sink; }
 };
+// A node's size for choosing which end of a link to split: a cluster's box
+// diagonal, an element's length.
+double size_of(const Node& n) { return n.cluster() ? 2 * n.radius : n.length; }
 static_assert(offsetof(Node, length) + sizeof(double) <= 64, "the hot fields fill the first cache line");
 
 // The operator's view of a node: the fields that pull_tables, push_down and
@@ -2110,8 +2126,8 @@ LinkError HierarchicalSolver::link_error(const Link& l, const std::vector<double
                                          bool geometry_only) const {
     const Node& r = m_nodes[static_cast<size_t>(l.r)];
     const Node& s = m_nodes[static_cast<size_t>(l.s)];
-    const double size_r = r.cluster() ? 2 * r.radius : r.length;
-    const double size_s = s.cluster() ? 2 * s.radius : s.length;
+    const double size_r = size_of(r);
+    const double size_s = size_of(s);
     if (l.uniform) {
         // A chain link carries the sender's mean at the exact etendue: the
         // power it moves is right for an even sender, and at most all of it
@@ -2454,7 +2470,14 @@ bool HierarchicalSolver::refine(const std::vector<double>& leaf_bmax, double exi
                                 decision[static_cast<size_t>(k)] = 4;  // closed whole: dropped
                                 continue;
                             }
-                            decision[static_cast<size_t>(k)] = can_r && (!can_s || g.split_r) ? 1 : 2;
+                            // A link nearly surely closed (the box proof
+                            // above left a gap) is split on its larger end,
+                            // not where the geometric error lies: what it
+                            // needs is a proof of closure, which a narrower
+                            // shaft gives more often and for less (see
+                            // box_proof_below).
+                            const bool split_r = l.tau <= box_proof_below ? size_of(r) >= size_of(s) : g.split_r;
+                            decision[static_cast<size_t>(k)] = can_r && (!can_s || split_r) ? 1 : 2;
                             above = true;
                             continue;
                         }
