@@ -323,12 +323,25 @@ double band_bound(const Segment& ci, const Segment& cj, const Segment* blockers,
             by_depth.begin());
         size_t left = right;                  // the run taken is by_depth[left, right)
         double across = 0, before = 0, after = 0;  // before, after: the run's reach in depth
-        while (across < needed && right - left < opaque_band_max_pieces && (left > 0 || right < n)) {
-            const bool take_left = right == n || (left > 0 && t0 - at(left - 1).mid < at(right).mid - t0);
-            const size_t q = take_left ? at(--left).piece : at(right++).piece;
+        auto take_piece = [&](size_t q) {
             across += std::abs(local[2 * q + 1].y - local[2 * q].y);
             before = std::max({before, t0 - local[2 * q].x, t0 - local[2 * q + 1].x});
             after = std::max({after, local[2 * q].x - t0, local[2 * q + 1].x - t0});
+        };
+        while (across < needed && right - left < opaque_band_max_pieces && (left > 0 || right < n)) {
+            const bool take_left = right == n || (left > 0 && t0 - at(left - 1).mid < at(right).mid - t0);
+            take_piece(take_left ? at(--left).piece : at(right++).piece);
+        }
+        // Pieces as near in depth as the farthest taken (a row of them at
+        // one depth, as in a blind) are taken too: which of a row's ties
+        // came first depends on the last bits of the coordinates, and a run
+        // cut inside the row would make the bound depend on them (on how
+        // the scene is scaled or placed).
+        if (right > left) {
+            const double reach = std::max(t0 - at(left).mid, at(right - 1).mid - t0);
+            const double tie = reach + 1e-9 * (xj - xi);
+            while (left > 0 && t0 - at(left - 1).mid <= tie) take_piece(at(--left).piece);
+            while (right < n && at(right).mid - t0 <= tie) take_piece(at(right++).piece);
         }
         const size_t taken = right - left;
         if (taken == 0 || !(across > 0)) return 0.0;

@@ -107,8 +107,17 @@ static_assert(sizeof(OpaqueBandScratch::buckets) / sizeof(OpaqueBandScratch::Buc
 /// Pieces in a band: those nearest to its depth until the lengths of their
 /// shadows across the pair's axis add up to this many times the section X
 /// (a dense forest's band then covers X with room for the drift), or
-/// opaque_band_max_pieces.
-inline constexpr double opaque_band_layers = 6;
+/// opaque_band_max_pieces. With 6, a quarter of the proofs of closure on
+/// the 10^5 forest at eps 10 (12 325 of 49 960, one thread) failed at a
+/// bin: the shadows, narrowed by their drift, left gaps. With 8, 2 260 of
+/// 25 110 (the proofs that close drop links whole, higher up the tree, so
+/// fewer are asked): that forest 7.4-7.5 -> 6.4-6.8 s on two threads
+/// (cluster visits 141 M -> 92 M), the 10^6 forest's solve 106 -> 99.5 s
+/// (2.45 G cluster visits against 3.21 G); 9 and 10 layers about as good
+/// (10.1 and 10.5 s against 9.6 s on one thread), 12 worse (more proofs
+/// past opaque_band_max_bins: 11.9 s). The 10^3 and 10^4 forests and
+/// data/forest.json at eps 0.1 and 1: the same errors, times within noise.
+inline constexpr double opaque_band_layers = 8;
 /// Shafts whose pieces' shadows add up to fewer layers than this over the
 /// whole slab (their sum over the shaft's mean width; with the bands'
 /// depths given, over the narrowest of their sections) are not tried: a
