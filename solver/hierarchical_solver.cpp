@@ -173,7 +173,8 @@ constexpr double closure_screen_spread = 0.04;
 // 1e-6 / 1e-10 / 1e-15 (736 / 295 / 6 links dropped whole): there the
 // proofs mostly replace closure screens' answers, which cost less.
 constexpr double box_proof_below = 1e-10;
-// Such a link whose proof leaves a gap is split on its larger end, not on
+// Such a link not shown closed whole (its proof left a gap, or none was
+// tried: two elements, or box_closure off) is split on its larger end, not on
 // the end with the larger geometric error: through a dense forest that is
 // a cluster's layered term (its members hiding each other), which split
 // the receivers while a ceiling element 20-45 units long stayed whole, and
@@ -2470,8 +2471,9 @@ bool HierarchicalSolver::refine(const std::vector<double>& leaf_bmax, double exi
                                 decision[static_cast<size_t>(k)] = 4;  // closed whole: dropped
                                 continue;
                             }
-                            // A link nearly surely closed (the box proof
-                            // above left a gap) is split on its larger end,
+                            // A link nearly surely closed (the density's
+                            // estimate at most box_proof_below) and not
+                            // shown so whole is split on its larger end,
                             // not where the geometric error lies: what it
                             // needs is a proof of closure, which a narrower
                             // shaft gives more often and for less (see
