@@ -164,13 +164,13 @@ struct Evaluator {
         const Interval window_wide{std::max(ai.a, aj.a), std::min(ai.b, aj.b)};
         const Interval window_narrow{std::max(ni.a, nj.a), std::min(ni.b, nj.b)};
         // At the bin's centre direction itself (no drift): the midpoint
-        // rule's sample (DirectionBounds::estimate).
-        auto at_centre = [&](size_t k) {
-            const double p = proj(k), q = proj(k + 1);
-            return Interval{std::min(p, q), std::max(p, q)};
-        };
-        const Interval ci = at_centre(0), cj = at_centre(2);
-        const Interval window_centre{std::max(ci.a, cj.a), std::min(ci.b, cj.b)};
+        // rule's sample (DirectionBounds::estimate), asked for or not.
+        auto at_centre = [](double p, double q) { return Interval{std::min(p, q), std::max(p, q)}; };
+        Interval window_centre{0, 0};
+        if (estimate) {
+            const Interval ci = at_centre(proj(0), proj(1)), cj = at_centre(proj(2), proj(3));
+            window_centre = {std::max(ci.a, cj.a), std::min(ci.b, cj.b)};
+        }
         // Fewest free lines: the narrow window, wide shadows; most: the
         // wide window, narrow shadows. Each piece's two shadows are written
         // in place and kept by advancing the count (no branch on whether
@@ -197,7 +197,7 @@ struct Evaluator {
             ns[mn] = sn;
             mn += static_cast<size_t>((sn.b > sn.a) & (sn.b > window_wide.a) & (sn.a < window_wide.b));
             if (estimate) {  // (the same way for every piece of a call)
-                const Interval sc{std::min(p, q), std::max(p, q)};
+                const Interval sc = at_centre(p, q);
                 cs[mc] = sc;
                 mc += static_cast<size_t>((sc.b > window_centre.a) & (sc.a < window_centre.b));
             }
