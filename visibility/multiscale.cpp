@@ -903,11 +903,14 @@ MultiscaleResult MultiscaleVisibility::form_factor_skipping(const Segment& i, co
             const double slab = slab_layers / m_layers_per_depth, half = 0.5 * slab;
             const bool from_i = narrower_at_i(g.ci, g.cj);
             double t0[opaque_band_count], slab_lo[opaque_band_count], slab_hi[opaque_band_count];
-            for (int k = 0; k < opaque_band_count; ++k) {
-                t0[k] = from_i ? xi + (k + 0.5) * slab : xj - (k + 0.5) * slab;  // the bands' depths
-                slab_lo[k] = t0[k] - half;
-                slab_hi[k] = t0[k] + half;
-            }
+            auto place = [&](double lead) {
+                for (int k = 0; k < opaque_band_count; ++k) {
+                    t0[k] = from_i ? xi + lead + (k + 0.5) * slab : xj - lead - (k + 0.5) * slab;  // the bands' depths
+                    slab_lo[k] = t0[k] - half;
+                    slab_hi[k] = t0[k] + half;
+                }
+            };
+            place(0);
             auto in_slabs = [&](double lo, double hi) {
                 for (int k = 0; k < opaque_band_count; ++k)
                     if (hi >= slab_lo[k] && lo <= slab_hi[k]) return true;
@@ -923,18 +926,54 @@ MultiscaleResult MultiscaleVisibility::form_factor_skipping(const Segment& i, co
             };
             auto& found = ws.band.blockers;  // whole segments
             auto& clipped = ws.blockers;     // (scratch)
-            found.clear();
-            const bool closed = walk(box_in_slabs, [&](int, const Segment& b) {
-                const double da = at_depth(b.a), db = at_depth(b.b);
-                if (!in_slabs(std::min(da, db), std::max(da, db))) return false;
-                // The whole segment goes to the bands (they clip it in depth
-                // only): its shadow must reach past the shaft's sides, as the
-                // lines they check may, by their drift.
-                clipped.clear();
-                const bool alone = add_blocker(shaft, b, size, clipped);
-                if (!clipped.empty()) found.push_back(b);
-                return alone;
-            });
+            // The slabs start where the blockers do: a shaft from a lamp
+            // hung above a forest crosses metres of empty room first, and
+            // slabs laid there hold few pieces or none, their bands too
+            // thin to close. So when the pieces the slabs found all lie
+            // more than half a slab from the narrower end, the slabs move
+            // to the nearest of them, and when they found none, past
+            // themselves, as long as the three still fit in the shaft.
+            // (Where they are laid is a choice of cost only: the bands'
+            // proof holds wherever they are.) On the 10^6 forest at eps 10
+            // (`scripts/make-scene 1000000 --seed 1 --density 30`, 2
+            // threads) the lamp's links' queries took 29.9 thread-seconds
+            // before, 3.5 after (528 000 against 228 000: more links from
+            // it are closed whole); cluster visits 2.45 G -> 1.56 G.
+            // nearest: how far from the slabs' end the nearest piece found lies.
+            double nearest = infinity;
+            auto walk_slabs = [&] {
+                found.clear();
+                nearest = infinity;
+                return walk(box_in_slabs, [&](int, const Segment& b) {
+                    const double da = at_depth(b.a), db = at_depth(b.b);
+                    if (!in_slabs(std::min(da, db), std::max(da, db))) return false;
+                    // The whole segment goes to the bands (they clip it in depth
+                    // only): its shadow must reach past the shaft's sides, as the
+                    // lines they check may, by their drift.
+                    clipped.clear();
+                    const bool alone = add_blocker(shaft, b, size, clipped);
+                    if (!clipped.empty()) {
+                        found.push_back(b);
+                        nearest = std::min(nearest, from_i ? std::min(da, db) - xi : xj - std::max(da, db));
+                    }
+                    return alone;
+                });
+            };
+            bool closed = walk_slabs();
+            double lead = 0;
+            while (!closed) {
+                double next;
+                if (std::isfinite(nearest)) {
+                    if (nearest <= lead + half) break;
+                    next = nearest;
+                } else {
+                    next = lead + opaque_band_count * slab;
+                }
+                if (next + opaque_band_count * slab > depth) break;
+                lead = next;
+                place(lead);
+                closed = walk_slabs();
+            }
             if (closed || (found.size() >= m_min_pieces_to_prove_closed && settled_by_bands(found, t0))) {
                 stats.clusters_visited += out.clusters_visited;
                 ++stats.queries;
