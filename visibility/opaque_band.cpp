@@ -158,6 +158,22 @@ int bucket_group_size(const Band& band, double h, int bins, const OpaqueBandScra
     return std::isfinite(g) ? static_cast<int>(std::clamp(g, 1.0, static_cast<double>(bins))) : (g > 0 ? bins : 1);
 }
 
+// The band's free length at every direction of [c - h, c + h], summed
+// over its sections, with its pieces bucketed (bb) for a group of bins
+// holding those directions; more than `bar` (stopped early) when it
+// exceeds bar.
+double free_within(const Band& band, const OpaqueBandScratch::Buckets& bb, double c, double h, double bar,
+                   OpaqueBandScratch& ws) {
+    const Vec2 n{-std::sin(c), std::cos(c)};  // the centre direction's normal, for every section
+    const int S = band.sections;
+    double sum = 0;
+    for (int sct = 0; sct < S && sum <= bar; ++sct) {
+        const size_t f = bb.first[static_cast<size_t>(sct)], l = bb.first[static_cast<size_t>(sct) + 1];
+        sum += uncovered(band, sct, n, h, bb.items.data() + f, l - f, bar - sum, ws);
+    }
+    return sum;
+}
+
 // The band's free length at every direction of bin b ([c - h, c + h], of
 // `bins` over [-delta, delta]), summed over its sections; more than `bar`
 // (and so stopped early, the sum unfinished) when it exceeds bar.
@@ -170,15 +186,7 @@ double band_free(const Band& band, OpaqueBandScratch::Buckets& bb, int b, int bi
         bucket_band(band, bb, -delta + 2 * b0 * h, -delta + 2 * b1 * h, h, ws);
         bb.group = group;
     }
-    const double c = -delta + (2 * b + 1) * h;
-    const Vec2 n{-std::sin(c), std::cos(c)};  // the bin's centre direction's normal, for every section
-    const int S = band.sections;
-    double sum = 0;
-    for (int sct = 0; sct < S && sum <= bar; ++sct) {
-        const size_t f = bb.first[static_cast<size_t>(sct)], l = bb.first[static_cast<size_t>(sct) + 1];
-        sum += uncovered(band, sct, n, h, bb.items.data() + f, l - f, bar - sum, ws);
-    }
-    return sum;
+    return free_within(band, bb, -delta + (2 * b + 1) * h, h, bar, ws);
 }
 
 }  // namespace
@@ -401,6 +409,33 @@ double band_bound(const Segment& ci, const Segment& cj, const Segment* blockers,
         bb.group = -1;  // none made for these bands yet
         bb.group_size = 0;
     }
+    // A bin that leaves more free than its allowance is checked again in
+    // halves (opaque_band_halvings): halves(c, hh, d, room) checks the
+    // halves of [c - hh, c + hh] with every band built (their buckets are
+    // for the bin's group of bins, which holds both halves; a half's
+    // narrower drift only narrows what they must hold), a half that leaves
+    // more free than the room left halved again, d times at most. Returns
+    // the sum over the halves of their half-width times their least free
+    // length (each an upper bound at every direction of its half, as a
+    // bin's is), more than room when it exceeds it.
+    auto halves = [&](auto&& self, double c, double hh, int d, double room) -> double {
+        if (d <= 0) return not_shown;
+        const double h2 = 0.5 * hh;
+        double sum = 0;
+        for (const double c2 : {c - h2, c + h2}) {
+            double least = not_shown;
+            for (size_t k = 0; k < bands.size() && least > 0; ++k) {
+                const double bar = std::min(least, (room - sum) / h2);
+                const double free = free_within(bands[k], ws.buckets[k], c2, h2, bar, ws);
+                if (free <= bar) least = free;
+            }
+            double part = h2 * least;
+            if (!(part <= room - sum)) part = self(self, c2, h2, d - 1, room - sum);
+            if (!(part <= room - sum)) return not_shown;
+            sum += part;
+        }
+        return sum;
+    };
     for (int b = 0; b < bins; ++b) {
         const double allowance = (limit - total) / h;  // the most this bin may leave free
         double best = not_shown;
@@ -410,7 +445,12 @@ double band_bound(const Segment& ci, const Segment& cj, const Segment* blockers,
             const double sum = band_free(bands[static_cast<size_t>(k)], ws.buckets[static_cast<size_t>(k)], b, bins, delta, h, bar, ws);
             if (sum <= bar) best = sum;  // finished, and the least so far
         }
-        if (!(best <= allowance)) return not_shown;
+        if (!(best <= allowance)) {
+            const double part = halves(halves, -delta + (2 * b + 1) * h, h, options.halvings, limit - total);
+            if (!(part <= limit - total)) return not_shown;
+            total += part;
+            continue;
+        }
         total += h * best;
     }
     return total;

@@ -145,8 +145,14 @@ inline constexpr int opaque_band_max_bins = 128;
 /// that run (the 10^4 forest at eps 1: 12.6 s trying all, 10.9 s with
 /// this cap, 11.4 s without the proofs; the 1000-segment forest at eps 4:
 /// +10% instructions trying all, +1.4% with it, the same shafts closed to
-/// 1%).
-inline constexpr double opaque_band_max_checks = 256;
+/// 1%). That cap was 256 until the box proofs (box_closure.h) of the 10^6
+/// forest at eps 10 met it: 78 000 of their proofs were refused for it
+/// (wide shafts: boxes of 3-10 units 40-60 apart). With 1024 the form
+/// factors took 42.6 s instead of 46.2 s (one run each; cluster visits
+/// 1.56 G -> 1.17 G), about the same with 4096; on the 10^5 forest (one
+/// thread, callgrind) 75.1 G instructions against 76.0 G with 256, 76.1 G
+/// with 2048, 76.5 G with 4096.
+inline constexpr double opaque_band_max_checks = 1024;
 /// With a tolerance (band_bound's limit > 0: a bound within it answers the
 /// query), the bins need only keep the drift within the mean shadow, and the
 /// cap is higher: a bound pays for shafts across a forest, where the
@@ -159,8 +165,21 @@ inline constexpr double opaque_band_max_checks = 256;
 inline constexpr double band_bound_drift = 1;
 inline constexpr double band_bound_max_checks = 1024;
 
+/// A bin whose bands all leave more free than its share is checked again
+/// in halves, each half that does the same halved again, this many times
+/// at most (a gap may be the drift's, not the band's: within a half each
+/// piece drifts half as far, and its narrowed shadow is wider). A true gap
+/// at some direction stays open at any width, and costs about two checks
+/// per band and halving on its way down. On the 10^6 forest at eps 10
+/// (`scripts/make-scene 1000000 --seed 1 --density 30`, 2 threads, one run
+/// each): form factors 42.6 s with none, 30.9 / 30.3 / 28.7 / 27.7 s with
+/// 2 / 3 / 5 / 8 (cluster visits 1.17 G -> 0.77 G: links closed whole
+/// higher up the tree).
+inline constexpr int opaque_band_halvings = 8;
+
 struct BandOptions {
     double limit = 0;  ///< give up once the bound would exceed this (0: the proof of closure)
+    int halvings = opaque_band_halvings;  ///< see above (0: bins of one width)
     double max_checks = opaque_band_max_checks;  ///< see above
     double drift = opaque_band_drift;            ///< bins narrow enough for this drift (see above)
     /// The bands' depths t0 along the pair's axis (PairFrame of ci, cj),

@@ -239,6 +239,66 @@ TEST_CASE("opaque band: on random crowded shafts, the bound is never below the e
     CHECK(tight * 2 >= dense);
 }
 
+TEST_CASE("opaque band: bins checked again in halves close shafts one width leaves open, and only closed ones") {
+    // A bin's check narrows each shadow by how far its piece drifts within
+    // the bin; halves drift half as far. Halving may only add proofs (a
+    // shaft closed at one width is closed with halvings: the first pass is
+    // the same), every proof must be right, and on crowded random shafts
+    // some must be added, or the halving does nothing. As bounds (with a
+    // limit, the multi-scale module's use), halving may only lower them,
+    // never below the exact exchange.
+    std::mt19937_64 rng(41);
+    OpaqueBandScratch scratch;
+    BandOptions one_width;
+    one_width.halvings = 0;
+    const BandOptions halved;  // opaque_band_halvings
+    REQUIRE(halved.halvings > 0);
+    int closed_once = 0, added = 0, bounds = 0, lowered = 0;
+    for (const int n : {200, 300, 500}) {
+        for (int rep = 0; rep < 40; ++rep) {
+            const RandomShaft r = random_shaft(n, rng);
+            const double unocc = exchange_crossed_strings(r.ci, r.cj);
+            const double exact = exact_exchange(r.ci, r.cj, r.sticks);
+            const bool closed_one = band_bound(r.ci, r.cj, r.sticks.data(), r.sticks.size(), one_width, scratch) == 0;
+            const bool closed_halved = band_bound(r.ci, r.cj, r.sticks.data(), r.sticks.size(), halved, scratch) == 0;
+            if (closed_one) {
+                ++closed_once;
+                CHECK_MESSAGE(closed_halved, "n ", n, " rep ", rep, ": closed at one width, not with halvings");
+            } else if (closed_halved) {
+                ++added;
+            }
+            if (closed_halved)
+                CHECK_MESSAGE(exact <= rounding_tol * unocc, "n ", n, " rep ", rep, ": shown closed, exact ", exact,
+                              " of ", unocc);
+            // As a bound: with no limit nothing is halved; with a limit of
+            // half that bound the bins at one width take the sum past it
+            // (not shown), and halved they may keep within it.
+            BandOptions b_one = bounding();
+            b_one.halvings = 0;
+            const double u_one = band_bound(r.ci, r.cj, r.sticks.data(), r.sticks.size(), b_one, scratch);
+            if (!(std::isfinite(u_one) && u_one > 0)) continue;
+            ++bounds;
+            CHECK(band_bound(r.ci, r.cj, r.sticks.data(), r.sticks.size(), bounding(), scratch) == u_one);
+            BandOptions b_half = bounding();
+            b_half.limit = 0.5 * u_one;
+            const double u_halved = band_bound(r.ci, r.cj, r.sticks.data(), r.sticks.size(), b_half, scratch);
+            b_half.halvings = 0;
+            CHECK(std::isinf(band_bound(r.ci, r.cj, r.sticks.data(), r.sticks.size(), b_half, scratch)));
+            if (std::isfinite(u_halved)) {
+                ++lowered;
+                CHECK(u_halved <= b_half.limit);
+                CHECK_MESSAGE(u_halved >= exact - rounding_tol * unocc, "n ", n, " rep ", rep, ": bound ", u_halved,
+                              " below exact ", exact);
+            }
+        }
+    }
+    MESSAGE(closed_once, " shown closed at one width, ", added, " more with halvings; ", bounds, " bounds, ", lowered,
+            " of them halved within half their one-width value");
+    CHECK(closed_once >= 3);
+    CHECK(added >= 1);
+    CHECK(lowered >= 1);
+}
+
 TEST_CASE("opaque band: the blind with a gap is bounded above its exchange, and the limit is kept") {
     const Blind b = Blind{}.without_b(0.45);
     OpaqueBandScratch scratch;
