@@ -927,7 +927,7 @@ MultiscaleResult MultiscaleVisibility::form_factor_skipping(const Segment& i, co
             auto& found = ws.band.blockers;  // whole segments
             auto& clipped = ws.blockers;     // (scratch)
             // The slabs start where the blockers do: a shaft from a lamp
-            // hung above a forest crosses metres of empty room first, and
+            // hung above a forest crosses units of empty room first, and
             // slabs laid there hold few pieces or none, their bands too
             // thin to close. So when the pieces the slabs found all lie
             // more than half a slab from the narrower end, the slabs move
@@ -939,7 +939,8 @@ MultiscaleResult MultiscaleVisibility::form_factor_skipping(const Segment& i, co
             // threads) the lamp's links' queries took 29.9 thread-seconds
             // before, 3.5 after (528 000 against 228 000: more links from
             // it are closed whole); cluster visits 2.45 G -> 1.56 G.
-            // nearest: how far from the slabs' end the nearest piece found lies.
+            // nearest: the depth of the nearest piece the slabs found,
+            // counted from the narrower end (as lead is).
             double nearest = infinity;
             auto walk_slabs = [&] {
                 found.clear();

@@ -395,8 +395,8 @@ double band_bound(const Segment& ci, const Segment& cj, const Segment* blockers,
     // middle band. Each bin takes the least of the bands' free lengths (each
     // band alone stops all but its own free lines); the other bands are
     // built when a bin needs them. The first bin that takes the sum past
-    // the limit ends the attempt (an open shaft usually shows it within a
-    // few bins).
+    // the limit, even in halves (below), ends the attempt (an open shaft
+    // usually shows it within a few bins).
     const double h_band = build_band(0);
     if (!(h_band > 0)) return not_shown;
     const double bins_wanted = std::max<double>(opaque_band_initial_bins, std::ceil(delta / h_band));

@@ -212,8 +212,8 @@ bool narrower_at_i(const Segment& ci, const Segment& cj);
 /// them), shafts with fewer than opaque_band_min_layers, or more than
 /// options.max_checks section checks (the middle band's sections times the
 /// bins). With limit 0 it is the proof that the shaft is closed: 0 or
-/// +infinity. The first bin that takes the sum past the limit ends the
-/// attempt.
+/// +infinity. The first bin that takes the sum past the limit, even
+/// checked in halves (options.halvings), ends the attempt.
 double band_bound(const Segment& ci, const Segment& cj, const Segment* blockers, size_t count,
                   const BandOptions& options, OpaqueBandScratch& scratch);
 

@@ -22,6 +22,36 @@ constexpr double exact_tol = 1e-12;
 // integrals over hundreds of arcs, each term exact to ~1e-15 of the
 // unoccluded value.
 constexpr double rounding_floor = 1e-12;
+
+// The shaft between c.i and c.j (D apart), closed, with at least
+// min_layers layers of shadow between them by the scene's density: shown
+// closed exactly, from the slabs alone, asked from i and from j, exact
+// (eps 0) or not.
+void check_closed_by_slabs(const test::Cloud& c, double D, double min_layers) {
+    test::CloudVisibility vis(c);
+    vis.multiscale.set_min_pieces_to_bound(32);
+    vis.multiscale.set_min_pieces_to_prove_closed(16);
+    const double layers = vis.multiscale.layers_per_depth() * D;
+    CAPTURE(layers);
+    REQUIRE(layers >= min_layers);
+    ExactWorkspace ws;
+    VisibilityStats st, ex_st;
+    const double unocc = form_factor_unoccluded(c.i, c.j);
+    REQUIRE(vis.exact.form_factor(c.i, c.j, 0, 1, ws, ex_st) <= rounding_floor * unocc);  // closed
+    for (const double eps : {0.0, 1e-3 * unocc}) {
+        CAPTURE(eps);
+        const long slabs_before = st.slabs;
+        const MultiscaleResult r = vis.multiscale.form_factor(c.i, c.j, 0, 1, eps, GammaRule::Bound, ws, st);
+        CHECK(r.F == 0);
+        CHECK(r.error_bound == 0);
+        CHECK(st.slabs == slabs_before + 1);  // settled by the slabs alone
+        const long slabs_reversed = st.slabs;
+        const MultiscaleResult back = vis.multiscale.form_factor(c.j, c.i, 1, 0, eps, GammaRule::Bound, ws, st);
+        CHECK(back.F == 0);
+        CHECK(back.error_bound == 0);
+        CHECK(st.slabs == slabs_reversed + 1);
+    }
+}
 }  // namespace
 
 TEST_CASE("cluster tables: tau_bar at the sampled directions equals the direct union") {
@@ -262,29 +292,9 @@ TEST_CASE("multiscale: a long tapered shaft's slabs lie at its narrow end") {
     }
     // The shaft's left side runs from (0, 0) to (-15, 30): x = -y / 2.
     for (double y = 0.2; y < D - 1; y += 0.05) c.segments.push_back({{-15, y}, {-0.5 * y - 1, y}});
-    test::CloudVisibility vis(c);
-    vis.multiscale.set_min_pieces_to_bound(32);
-    vis.multiscale.set_min_pieces_to_prove_closed(16);
-    const double layers = vis.multiscale.layers_per_depth() * D;
-    CAPTURE(layers);
-    REQUIRE(layers >= 72);  // a long shaft, slabs 8 layers thick: 3.3 deep at most
-    ExactWorkspace ws;
-    VisibilityStats st, ex_st;
-    const double unocc = form_factor_unoccluded(c.i, c.j);
-    REQUIRE(vis.exact.form_factor(c.i, c.j, 0, 1, ws, ex_st) <= rounding_floor * unocc);  // closed
-    for (const double eps : {0.0, 1e-3 * unocc}) {
-        CAPTURE(eps);
-        const long slabs_before = st.slabs;
-        const MultiscaleResult r = vis.multiscale.form_factor(c.i, c.j, 0, 1, eps, GammaRule::Bound, ws, st);
-        CHECK(r.F == 0);
-        CHECK(r.error_bound == 0);
-        CHECK(st.slabs == slabs_before + 1);  // settled by the slabs alone
-        // And the same shaft from j's side: the narrow end is now the far one.
-        const long slabs_reversed = st.slabs;
-        const MultiscaleResult back = vis.multiscale.form_factor(c.j, c.i, 1, 0, eps, GammaRule::Bound, ws, st);
-        CHECK(back.F == 0);
-        CHECK(st.slabs == slabs_reversed + 1);
-    }
+    // A long shaft, slabs 8 layers thick: 3.3 deep at most. Asked from
+    // j's side too, the narrow end is the far one.
+    check_closed_by_slabs(c, D, 72);
 }
 
 TEST_CASE("multiscale: a long shaft's slabs start where its blockers do, past an empty lead") {
@@ -308,29 +318,7 @@ TEST_CASE("multiscale: a long shaft's slabs start where its blockers do, past an
         for (double x = -0.85; x < 2; x += 0.4) c.segments.push_back({{x, y + 0.05}, {x + 0.4, y + 0.05}});
     }
     for (double y = 0.2; y < D - 0.1; y += 0.05) c.segments.push_back({{-20, y}, {-3, y}});
-    test::CloudVisibility vis(c);
-    vis.multiscale.set_min_pieces_to_bound(32);
-    vis.multiscale.set_min_pieces_to_prove_closed(16);
-    const double layers = vis.multiscale.layers_per_depth() * D;
-    CAPTURE(layers);
-    REQUIRE(layers >= 36 * 3);  // a long shaft, slabs 8 layers thick: under a unit deep, three under 3
-    ExactWorkspace ws;
-    VisibilityStats st, ex_st;
-    const double unocc = form_factor_unoccluded(c.i, c.j);
-    REQUIRE(vis.exact.form_factor(c.i, c.j, 0, 1, ws, ex_st) <= rounding_floor * unocc);  // closed
-    for (const double eps : {0.0, 1e-3 * unocc}) {
-        CAPTURE(eps);
-        const long slabs_before = st.slabs;
-        const MultiscaleResult r = vis.multiscale.form_factor(c.i, c.j, 0, 1, eps, GammaRule::Bound, ws, st);
-        CHECK(r.F == 0);
-        CHECK(r.error_bound == 0);
-        CHECK(st.slabs == slabs_before + 1);  // settled by the slabs alone
-        const long slabs_reversed = st.slabs;
-        const MultiscaleResult back = vis.multiscale.form_factor(c.j, c.i, 1, 0, eps, GammaRule::Bound, ws, st);
-        CHECK(back.F == 0);
-        CHECK(back.error_bound == 0);
-        CHECK(st.slabs == slabs_reversed + 1);
-    }
+    check_closed_by_slabs(c, D, 36 * 3);  // a long shaft, slabs 8 layers thick: under a unit deep, three under 3
 }
 
 TEST_CASE("multiscale: transmittance between clusters is in [0, 1] and within its bound of eps = 0") {
