@@ -158,27 +158,15 @@ int bucket_group_size(const Band& band, double h, int bins, const OpaqueBandScra
     return std::isfinite(g) ? static_cast<int>(std::clamp(g, 1.0, static_cast<double>(bins))) : (g > 0 ? bins : 1);
 }
 
-// The band's free length at every direction of [c - h, c + h], summed
-// over its sections, with its pieces bucketed (bb) for a group of bins
-// holding those directions; more than `bar` (stopped early) when it
-// exceeds bar.
-double free_within(const Band& band, const OpaqueBandScratch::Buckets& bb, double c, double h, double bar,
-                   OpaqueBandScratch& ws) {
-    const Vec2 n{-std::sin(c), std::cos(c)};  // the centre direction's normal, for every section
-    const int S = band.sections;
-    double sum = 0;
-    for (int sct = 0; sct < S && sum <= bar; ++sct) {
-        const size_t f = bb.first[static_cast<size_t>(sct)], l = bb.first[static_cast<size_t>(sct) + 1];
-        sum += uncovered(band, sct, n, h, bb.items.data() + f, l - f, bar - sum, ws);
-    }
-    return sum;
-}
-
-// The band's free length at every direction of bin b ([c - h, c + h], of
-// `bins` over [-delta, delta]), summed over its sections; more than `bar`
-// (and so stopped early, the sum unfinished) when it exceeds bar.
-double band_free(const Band& band, OpaqueBandScratch::Buckets& bb, int b, int bins, double delta, double h,
-                 double bar, OpaqueBandScratch& ws) {
+// The band's free length at every direction of [c - hh, c + hh], a part
+// of bin b (of `bins`, half-width h, over [-delta, delta]; the whole bin
+// or one of its halves), summed over its sections; more than `bar` (and
+// so stopped early, the sum unfinished) when it exceeds bar. The pieces
+// are bucketed for b's group of bins, which holds every direction of the
+// part; a part narrower than the bin drifts less, which only narrows what
+// the buckets must hold.
+double band_free(const Band& band, OpaqueBandScratch::Buckets& bb, int b, int bins, double delta, double h, double c,
+                 double hh, double bar, OpaqueBandScratch& ws) {
     if (bb.group_size == 0) bb.group_size = bucket_group_size(band, h, bins, ws);
     const int group = b / bb.group_size;
     if (bb.group != group) {
@@ -186,7 +174,14 @@ double band_free(const Band& band, OpaqueBandScratch::Buckets& bb, int b, int bi
         bucket_band(band, bb, -delta + 2 * b0 * h, -delta + 2 * b1 * h, h, ws);
         bb.group = group;
     }
-    return free_within(band, bb, -delta + (2 * b + 1) * h, h, bar, ws);
+    const Vec2 n{-std::sin(c), std::cos(c)};  // the part's centre direction's normal, for every section
+    const int S = band.sections;
+    double sum = 0;
+    for (int sct = 0; sct < S && sum <= bar; ++sct) {
+        const size_t f = bb.first[static_cast<size_t>(sct)], l = bb.first[static_cast<size_t>(sct) + 1];
+        sum += uncovered(band, sct, n, hh, bb.items.data() + f, l - f, bar - sum, ws);
+    }
+    return sum;
 }
 
 }  // namespace
@@ -409,49 +404,42 @@ double band_bound(const Segment& ci, const Segment& cj, const Segment* blockers,
         bb.group = -1;  // none made for these bands yet
         bb.group_size = 0;
     }
-    // A bin that leaves more free than its allowance is checked again in
-    // halves (opaque_band_halvings): halves(c, hh, d, room) checks the
-    // halves of [c - hh, c + hh] with every band built (their buckets are
-    // for the bin's group of bins, which holds both halves; a half's
-    // narrower drift only narrows what they must hold), a half that leaves
-    // more free than the room left halved again, d times at most. Returns
-    // the sum over the halves of their half-width times their least free
-    // length (each an upper bound at every direction of its half, as a
-    // bin's is), more than room when it exceeds it.
-    auto halves = [&](auto&& self, double c, double hh, int d, double room) -> double {
+    // settle(b, c, hh, d, room): the part [c - hh, c + hh] of bin b, hh
+    // times the least of the bands' free lengths there (each band alone
+    // stops all but its own free lines), building the next band only when
+    // the ones before leave some free. Where that exceeds room, the part is
+    // checked again in halves (a gap may be the drift's, not the bands':
+    // opaque_band_halvings), each half that exceeds what is left halved
+    // again, d times at most: the sum over the halves. not_shown when it
+    // exceeds room.
+    int tried = 1;  // bands built or found empty (band 0 above)
+    auto settle = [&](auto&& self, int b, double c, double hh, int d, double room) -> double {
+        const double allowance = room / hh;  // the most the part may leave free
+        double least = not_shown;
+        for (int k = 0; k < opaque_band_count && least > 0; ++k) {
+            if (k == static_cast<int>(bands.size())) {
+                if (k < tried) break;  // no piece
+                ++tried;
+                if (!(build_band(k) > 0)) break;
+            }
+            const double bar = std::min(least, allowance);
+            const double free = band_free(bands[static_cast<size_t>(k)], ws.buckets[static_cast<size_t>(k)], b, bins, delta, h, c,
+                                          hh, bar, ws);
+            if (free <= bar) least = free;  // finished, and the least so far
+        }
+        if (least <= allowance) return hh * least;
         if (d <= 0) return not_shown;
         const double h2 = 0.5 * hh;
-        double sum = 0;
-        for (const double c2 : {c - h2, c + h2}) {
-            double least = not_shown;
-            for (size_t k = 0; k < bands.size() && least > 0; ++k) {
-                const double bar = std::min(least, (room - sum) / h2);
-                const double free = free_within(bands[k], ws.buckets[k], c2, h2, bar, ws);
-                if (free <= bar) least = free;
-            }
-            double part = h2 * least;
-            if (!(part <= room - sum)) part = self(self, c2, h2, d - 1, room - sum);
-            if (!(part <= room - sum)) return not_shown;
-            sum += part;
-        }
-        return sum;
+        const double lower = self(self, b, c - h2, h2, d - 1, room);
+        if (lower == not_shown) return not_shown;
+        const double upper = self(self, b, c + h2, h2, d - 1, room - lower);
+        if (upper == not_shown) return not_shown;
+        return lower + upper;
     };
     for (int b = 0; b < bins; ++b) {
-        const double allowance = (limit - total) / h;  // the most this bin may leave free
-        double best = not_shown;
-        for (int k = 0; k < opaque_band_count && best > 0; ++k) {
-            if (k == static_cast<int>(bands.size()) && !(build_band(k) > 0)) break;  // no piece
-            const double bar = std::min(best, allowance);
-            const double sum = band_free(bands[static_cast<size_t>(k)], ws.buckets[static_cast<size_t>(k)], b, bins, delta, h, bar, ws);
-            if (sum <= bar) best = sum;  // finished, and the least so far
-        }
-        if (!(best <= allowance)) {
-            const double part = halves(halves, -delta + (2 * b + 1) * h, h, options.halvings, limit - total);
-            if (!(part <= limit - total)) return not_shown;
-            total += part;
-            continue;
-        }
-        total += h * best;
+        const double part = settle(settle, b, -delta + (2 * b + 1) * h, h, options.halvings, limit - total);
+        if (part == not_shown) return not_shown;
+        total += part;
     }
     return total;
 }
