@@ -801,12 +801,12 @@ private:
     // eps 10 went from 581 to 570 MB, its radiosity moved by 1.6e-10
     // relative L2.)
     std::vector<int32_t> m_gamma_slot;
-    std::vector<float> m_gamma;
+    std::vector<float, UninitializedAllocator<float>> m_gamma;  // (self_occlusion writes every slot)
     // Per table and direction bin: how far along that direction, from the
     // node's centre, the lobes seen from far along it lie on average (its
     // visible face; 0 where not measured): the point a cluster link's
     // geometry is taken from (unoccluded_coef). Empty: 0 everywhere.
-    std::vector<float> m_face;
+    std::vector<float, UninitializedAllocator<float>> m_face;  // (self_occlusion writes every row)
     double face_offset(const Node& n, Vec2 u) const {
         if (m_face.empty() || !n.cluster() || n.table < 0) return 0.0;
         return interpolate(&m_face[static_cast<size_t>(n.table) * directional_bins], bin_of(u));
@@ -1176,43 +1176,59 @@ void HierarchicalSolver::self_occlusion() {
         }
         asked.group_begin.push_back(static_cast<int32_t>(asked.group_node.size()));
     }
-    EnvelopeShares shares = cluster_visible_fractions(m_hierarchy, sides_at, asked, m_threads);
-    std::vector<double> A(static_cast<size_t>(m_tables_count) * K, 1.0);
-    std::vector<double> seen = std::move(shares.group);  // per child: its lobes' share seen from outside its parent
-    FLATRAD_ASSERT(seen.size() == static_cast<size_t>(slots) * K, "one group per slot");
-    std::vector<double> face(static_cast<size_t>(m_tables_count) * K, 0.0);
+    const EnvelopeShares shares = cluster_visible_fractions(m_hierarchy, sides_at, asked, m_threads);
+    FLATRAD_ASSERT(shares.groups == static_cast<size_t>(slots), "one group per slot");
+    if (std::all_of(shares.whole_by_bin.begin(), shares.whole_by_bin.end(), [](double a) { return a == 1.0; })) return;
+    // (The shares are held bin after bin, the clusters in this order: each
+    // loop below reads K runs in step.)
+    // Each table's face: the mean depth of what it shows along each bin,
+    // from its centre, within its radius (0 where it shows nothing).
     const auto& dirs = bin_directions();
-    for (size_t q = 0; q < clusters.size(); ++q) {
-        const Node& n = m_nodes[static_cast<size_t>(clusters[q])];
-        for (int b = 0; b < K; ++b) {
-            const size_t at = static_cast<size_t>(n.table) * K + static_cast<size_t>(b);
-            A[at] = shares.whole[q * K + static_cast<size_t>(b)];
-            const double o = shares.front[q * K + static_cast<size_t>(b)] - dot(n.center, dirs[static_cast<size_t>(b)]);
-            face[at] = std::isfinite(o) ? std::clamp(o, -n.radius, n.radius) : 0.0;
+    std::vector<int32_t> measured(static_cast<size_t>(m_tables_count), -1);  // per table: its place in `clusters`
+    for (size_t q = 0; q < clusters.size(); ++q)
+        measured[static_cast<size_t>(m_nodes[static_cast<size_t>(clusters[q])].table)] = static_cast<int32_t>(q);
+    m_face.resize(static_cast<size_t>(m_tables_count) * K);  // (every row written below)
+    m_gamma.resize(static_cast<size_t>(slots) * K);
+#pragma omp parallel num_threads(m_threads)
+    {
+#pragma omp for schedule(static)
+        for (size_t q = 0; q < clusters.size(); ++q) {
+            const Node& n = m_nodes[static_cast<size_t>(clusters[q])];
+            float* face = &m_face[static_cast<size_t>(n.table) * K];
+            for (int b = 0; b < K; ++b) {
+                const double o = shares.front(q, b) - dot(n.center, dirs[static_cast<size_t>(b)]);
+                face[b] = static_cast<float>(std::isfinite(o) ? std::clamp(o, -n.radius, n.radius) : 0.0);
+            }
+            // gamma = seen from outside the parent over seen from outside
+            // itself (a leaf cluster has no table: its own share is 1; so
+            // has a table cluster left unmeasured), at most 1 (the two are
+            // measured on different lines, and what is seen from outside
+            // the parent is seen from outside the child); 1 where the child
+            // shows nothing along that bin anyway.
+            for (int ch = n.child; ch < n.child + n.nchild; ++ch) {
+                const Node& c = m_nodes[static_cast<size_t>(ch)];
+                const size_t sl = static_cast<size_t>(slot[static_cast<size_t>(ch)]);
+                float* g = &m_gamma[sl * K];
+                const int32_t own = c.table >= 0 ? measured[static_cast<size_t>(c.table)] : -1;
+                for (int b = 0; b < K; ++b) {
+                    const double seen = shares.group(sl, b);
+                    if (c.table < 0) {
+                        g[b] = static_cast<float>(seen);
+                        continue;
+                    }
+                    const double a = own >= 0 ? shares.whole(static_cast<size_t>(own), b) : 1.0;
+                    g[b] = static_cast<float>(a > 0 ? std::min(1.0, seen / a) : 1.0);
+                }
+            }
         }
+        // The tables left unmeasured face their centre.
+#pragma omp for schedule(static)
+        for (size_t t = 0; t < measured.size(); ++t)
+            if (measured[t] < 0) std::fill_n(&m_face[t * K], K, 0.0f);
     }
-    if (std::all_of(A.begin(), A.end(), [](double a) { return a == 1.0; })) return;
     m_sensitivity_all = m_sensitivity;
     m_hidden_below.assign(static_cast<size_t>(m_tables_count), 0);
-    // gamma = seen from outside the parent over seen from outside itself
-    // (a leaf cluster has no table: its own share is 1), at most 1 (the
-    // two are measured on different lines, and what is seen from outside
-    // the parent is seen from outside the child); 1 where the child shows
-    // nothing along that bin anyway.
-    for (int k : clusters) {
-        const Node& n = m_nodes[static_cast<size_t>(k)];
-        for (int ch = n.child; ch < n.child + n.nchild; ++ch) {
-            const Node& c = m_nodes[static_cast<size_t>(ch)];
-            double* g = &seen[static_cast<size_t>(slot[static_cast<size_t>(ch)]) * K];
-            if (c.table < 0) continue;
-            const double* own = &A[static_cast<size_t>(c.table) * K];
-            for (int b = 0; b < K; ++b) g[b] = own[b] > 0 ? std::min(1.0, g[b] / own[b]) : 1.0;
-        }
-    }
-    m_gamma.assign(seen.begin(), seen.end());
-    seen = {};
     m_gamma_slot = std::move(slot);
-    m_face.assign(face.begin(), face.end());
     // Children before parents: a table's sensitivity becomes the sum of
     // its children's (final) sensitivities, each times its gamma.
     double sum[K];

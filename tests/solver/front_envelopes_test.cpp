@@ -91,12 +91,12 @@ void check_against_oracle(const std::vector<Segment>& segs, const std::vector<ui
             }
             CAPTURE(c);
             CAPTURE(k);
-            const double whole = got.whole[c * K + static_cast<size_t>(k)];
+            const double whole = got.whole(c, k);
             CHECK(whole == doctest::Approx(all > 0 ? seen / all : 1.0).epsilon(rounding_tolerance));
             if (seen > 0)
-                CHECK(got.front[c * K + static_cast<size_t>(k)] == doctest::Approx(depth / seen).epsilon(rounding_tolerance));
+                CHECK(got.front(c, k) == doctest::Approx(depth / seen).epsilon(rounding_tolerance));
             else
-                CHECK(std::isnan(got.front[c * K + static_cast<size_t>(k)]));
+                CHECK(std::isnan(got.front(c, k)));
             // Each group: its members' seen widths over their facing widths.
             for (int32_t g = s.clusters.group_begin[c]; g < s.clusters.group_begin[c + 1]; ++g) {
                 const ClusterNode& gn = s.h.node(s.clusters.group_node[static_cast<size_t>(g)]);
@@ -106,7 +106,7 @@ void check_against_oracle(const std::vector<Segment>& segs, const std::vector<ui
                     gs += o[static_cast<size_t>(q - cn.first)].seen;
                     ga += o[static_cast<size_t>(q - cn.first)].facing_width;
                 }
-                CHECK(got.group[static_cast<size_t>(g) * K + static_cast<size_t>(k)] ==
+                CHECK(got.group(static_cast<size_t>(g), k) ==
                       doctest::Approx(ga > 0 ? gs / ga : 1.0).epsilon(rounding_tolerance));
             }
         }
@@ -141,9 +141,9 @@ TEST_CASE("front envelopes: every cluster of random sticks as visible_fraction's
             const size_t g0 = static_cast<size_t>(s.clusters.group_begin[c]);
             for (int k = 0; k < K; ++k) {
                 CAPTURE(k);
-                CHECK(got.whole[c * K + static_cast<size_t>(k)] == doctest::Approx(out[k]).epsilon(rounding_tolerance));
+                CHECK(got.whole(c, k) == doctest::Approx(out[k]).epsilon(rounding_tolerance));
                 for (size_t g = 0; g < 2; ++g)
-                    CHECK(got.group[(g0 + g) * K + static_cast<size_t>(k)] ==
+                    CHECK(got.group(g0 + g, k) ==
                           doctest::Approx(group_out[g * K + static_cast<size_t>(k)]).epsilon(rounding_tolerance));
             }
         }
@@ -165,7 +165,7 @@ TEST_CASE("front envelopes: hundreds of sticks, some that cannot block, against 
     const EnvelopeShares got = cluster_visible_fractions(s.h, s.sides_at, s.clusters, 2);
     // The root holds all 300, in layers: some members are hidden.
     double least = 1;
-    for (int k = 0; k < K; ++k) least = std::min(least, got.whole[static_cast<size_t>(k)]);
+    for (int k = 0; k < K; ++k) least = std::min(least, got.whole(0, k));
     CHECK(least < 0.9);
     check_against_oracle(segs, sides, s, got);
 }
@@ -187,9 +187,9 @@ TEST_CASE("front envelopes: crossing segments split where they cross (closed for
     for (int k = 0; k < K; ++k)
         if (dot(dirs[static_cast<size_t>(k)], Vec2{0, 1}) > dot(dirs[static_cast<size_t>(up)], Vec2{0, 1})) up = k;
     REQUIRE(dirs[static_cast<size_t>(up)].y == doctest::Approx(1.0));
-    CHECK(got.whole[static_cast<size_t>(up)] == doctest::Approx(0.5));
-    CHECK(got.group[static_cast<size_t>(up)] == doctest::Approx(0.5));
-    CHECK(got.front[static_cast<size_t>(up)] == doctest::Approx(0.5));
+    CHECK(got.whole(0, up) == doctest::Approx(0.5));
+    CHECK(got.group(0, up) == doctest::Approx(0.5));
+    CHECK(got.front(0, up) == doctest::Approx(0.5));
     // Every bin: the diagonals' widths across u are proportional to |u.x -
     // u.y| and |u.x + u.y|; they cross at both middles, so the narrower
     // one is in front over half of its width and the wider one is seen
@@ -198,7 +198,7 @@ TEST_CASE("front envelopes: crossing segments split where they cross (closed for
         const Vec2 u = dirs[static_cast<size_t>(k)];
         const double w1 = std::abs(u.x - u.y), w2 = std::abs(u.x + u.y);
         CAPTURE(k);
-        CHECK(got.whole[static_cast<size_t>(k)] == doctest::Approx(std::max(w1, w2) / (w1 + w2)));
+        CHECK(got.whole(0, k) == doctest::Approx(std::max(w1, w2) / (w1 + w2)));
     }
 }
 
@@ -208,11 +208,11 @@ TEST_CASE("front envelopes: coordinates near the largest double leave bins unmea
     const std::vector<uint8_t> sides(3, left_side | right_side | blocks);
     const Setup s = every_cluster(segs, sides, 1);
     const EnvelopeShares got = cluster_visible_fractions(s.h, s.sides_at, s.clusters);
-    for (double v : got.whole) {
+    for (double v : got.whole_by_bin) {
         CHECK(v >= 0.0);
         CHECK(v <= 1.0);
     }
-    for (double v : got.group) {
+    for (double v : got.group_by_bin) {
         CHECK(v >= 0.0);
         CHECK(v <= 1.0);
     }
