@@ -317,12 +317,12 @@ EnvelopeShares cluster_visible_fractions(const Hierarchy& h, const std::vector<u
     std::vector<int32_t> non_blockers;
     for (size_t q = 0; q < sides_at.size(); ++q)
         if (!(sides_at[q] & blocks)) non_blockers.push_back(static_cast<int32_t>(q));
-    // Per cluster, found once for every pass (flat arrays: a vector per
+    // Per cluster, found once for every pass: its groups as (first place,
+    // group) by first place, at group_begin[c] on, and its non-blockers,
+    // non_blockers[range.first, range.second). (Flat arrays: a vector per
     // cluster, and a search of the whole scene's non-blockers per cluster
     // and pass, kept the passes waiting on memory: 5.2 s -> 3.6 s on the
-    // 10^6 forest, two threads): its
-    // groups as (first place, group) by first place, at group_begin[c] on,
-    // and its non-blockers, non_blockers[range.first, range.second).
+    // 10^6 forest, two threads.)
     std::vector<std::pair<int32_t, int32_t>> by_first(G);
     std::vector<std::pair<int32_t, int32_t>> nb_range(C, {0, 0});
     for (size_t c = 0; c < C; ++c) {
