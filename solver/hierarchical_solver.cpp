@@ -821,8 +821,8 @@ private:
     std::vector<int32_t> m_receivers;
     std::vector<int> m_leaves;           // element leaves
     int m_element_leaves = 0;
-    std::vector<int> m_leaf_index;       // node -> index in m_leaves, -1 otherwise
-    std::vector<OpNode> m_op;            // per node (collect_leaves)
+    std::vector<int, UninitializedAllocator<int>> m_leaf_index;  // node -> index in m_leaves, -1 otherwise (collect_leaves)
+    std::vector<OpNode, UninitializedAllocator<OpNode>> m_op;  // per node (collect_leaves, which writes each as it grows)
     // The operator's passes on several threads (build_op_schedule): disjoint
     // subtrees, each ascending from its top node (a frontier node), largest
     // first; and, ascending, the nodes above them with the frontier nodes.
@@ -2584,37 +2584,61 @@ bool HierarchicalSolver::refine(const std::vector<double>& leaf_bmax, double exi
 }
 
 void HierarchicalSolver::collect_leaves() {
-    m_leaves.clear();
-    m_leaf_index.assign(m_nodes.size(), -1);
-    for (size_t k = 0; k < m_nodes.size(); ++k)
-        if (m_nodes[k].kind == Kind::Element && m_nodes[k].child < 0) {
-            m_leaf_index[k] = static_cast<int>(m_leaves.size());
-            m_leaves.push_back(static_cast<int>(k));
+    // In slices side by side (the serial loop's result, leaf indices in node
+    // order): each slice counts its element leaves, then fills its own
+    // OpNodes and leaf indices from where the slices before it end. Both
+    // passes read millions of 192-byte nodes (10^6 forest: 0.3 s a solve on
+    // one thread).
+    const size_t N = m_nodes.size();
+    m_leaf_index.resize(N);
+    m_op.resize(N);
+    std::vector<size_t> before;  // element leaves in the slices before each
+    const auto is_leaf = [](const Node& n) { return n.kind == Kind::Element && n.child < 0; };
+#pragma omp parallel num_threads(m_threads) if (N >= op_parallel_min_nodes)
+    {
+#pragma omp single
+        before.assign(static_cast<size_t>(omp_get_num_threads()) + 1, 0);  // (the team may be smaller than asked)
+        const size_t T = before.size() - 1, t = static_cast<size_t>(omp_get_thread_num());
+        const size_t lo = N * t / T, hi = N * (t + 1) / T;
+        size_t count = 0;
+        for (size_t k = lo; k < hi; ++k) count += is_leaf(m_nodes[k]) ? 1 : 0;
+        before[t + 1] = count;
+#pragma omp barrier
+#pragma omp single
+        {
+            for (size_t u = 0; u < T; ++u) before[u + 1] += before[u];
+            m_leaves.resize(before[T]);
         }
-    m_element_leaves = static_cast<int>(m_leaves.size());
-    m_op.resize(m_nodes.size());
-    for (size_t k = 0; k < m_nodes.size(); ++k) {
-        const Node& n = m_nodes[k];
-        OpNode& o = m_op[k];
-        o.parent = n.parent;
-        o.child = n.child;
-        o.nchild = n.nchild;
-        o.table = n.table;
-        o.leaf = m_leaf_index[k];
-        o.kind = n.kind;
-        o.leaf_cluster = n.leaf_cluster;
-        o.normal = n.normal;
-        o.length = n.length;
-        o.chain = n.chain;
-        const Node* p = n.parent >= 0 ? &m_nodes[static_cast<size_t>(n.parent)] : nullptr;
-        o.side = !n.cluster() && p && p->cluster();
-        o.up_table = -1;
-        if (n.cluster() && p)
-            o.up_table = p->table;
-        else if (o.side && p->parent >= 0)
-            o.up_table = m_nodes[static_cast<size_t>(p->parent)].table;
-        o.lobe = o.side && o.up_table >= 0 ? lobe_bins(n.normal) : 0;  // (push_node reads it there alone)
+        size_t next = before[t];
+        for (size_t k = lo; k < hi; ++k) {
+            const Node& n = m_nodes[k];
+            m_leaf_index[k] = -1;
+            if (is_leaf(n)) {
+                m_leaf_index[k] = static_cast<int>(next);
+                m_leaves[next++] = static_cast<int>(k);
+            }
+            OpNode& o = m_op[k];
+            o.parent = n.parent;
+            o.child = n.child;
+            o.nchild = n.nchild;
+            o.table = n.table;
+            o.leaf = m_leaf_index[k];
+            o.kind = n.kind;
+            o.leaf_cluster = n.leaf_cluster;
+            o.normal = n.normal;
+            o.length = n.length;
+            o.chain = n.chain;
+            const Node* p = n.parent >= 0 ? &m_nodes[static_cast<size_t>(n.parent)] : nullptr;
+            o.side = !n.cluster() && p && p->cluster();
+            o.up_table = -1;
+            if (n.cluster() && p)
+                o.up_table = p->table;
+            else if (o.side && p->parent >= 0)
+                o.up_table = m_nodes[static_cast<size_t>(p->parent)].table;
+            o.lobe = o.side && o.up_table >= 0 ? lobe_bins(n.normal) : 0;  // (push_node reads it there alone)
+        }
     }
+    m_element_leaves = static_cast<int>(m_leaves.size());
     build_op_schedule();
 }
 
