@@ -383,6 +383,10 @@ struct Link {
     // Made by a split (children_links, self_links), its geometry not
     // computed yet: the next wave's decision computes it (make_link) first.
     bool fresh = false;
+    // The pair of sides whose proof of closure last failed for this link or
+    // the link it was split from (box_shown_closed's first_pair, + 1; 0:
+    // none): proven first the next time (shown_closed_whole).
+    uint8_t box_pair = 0;
     double coef = 0;
     float tau = 1;            // transmittance (cluster links), F / F_unoccluded (element links)
     float vis_err = 0;        // visibility bound: on tau (cluster links) or on F (element links)
@@ -678,7 +682,7 @@ private:
     double kernel_variation(const Node& r, const Node& s, double Fu) const;
     TransmittanceResult link_transmittance(int r, int s, ExactWorkspace& ws, VisibilityStats& st) const;
     bool behind_closure_screen(int e, const Box& region, ExactWorkspace& ws, VisibilityStats& st) const;
-    bool shown_closed_whole(const Link& l, ExactWorkspace& ws, VisibilityStats& st) const;
+    bool shown_closed_whole(Link& l, ExactWorkspace& ws, VisibilityStats& st) const;
     Box cluster_target_region(int hnode, Vec2 from) const;
     int split_element(int node);
     void pull_tables(const double* leaf_value, std::vector<double>& Bn, TableArray& I,
@@ -1467,6 +1471,7 @@ void HierarchicalSolver::children_links(const Link& l, bool split_r, LinkVector&
         // Halves of an element link lie in its shaft: an empty shaft stays empty.
         k.clear = l.clear && !nr.cluster() && !ns.cluster();
         k.fresh = true;
+        k.box_pair = l.box_pair;  // (its ends are halves of l's: the same gap is likely)
         out.push_back(k);
     }
 }
@@ -2006,17 +2011,24 @@ bool HierarchicalSolver::behind_closure_screen(int e, const Box& region, ExactWo
 // (visibility/box_closure.h): from an element's lit side, or from anywhere
 // in a cluster's box, to anywhere in the other end's cluster box, the
 // segments of either end's skipped node not counted (link_transmittance's
-// skips). Element pairs are left to their own query.
-bool HierarchicalSolver::shown_closed_whole(const Link& l, ExactWorkspace& ws, VisibilityStats& st) const {
+// skips). Element pairs are left to their own query. The pair of sides
+// whose proof failed for the link, or for the link it was split from, is
+// proven first (Link::box_pair), and a failure leaves its own there.
+bool HierarchicalSolver::shown_closed_whole(Link& l, ExactWorkspace& ws, VisibilityStats& st) const {
     const Node& nr = m_nodes[static_cast<size_t>(l.r)];
     const Node& ns = m_nodes[static_cast<size_t>(l.s)];
     const auto skip = [&](int h) { return m_tau_skip[static_cast<size_t>(h)]; };
-    if (nr.cluster() && ns.cluster())
-        return m_vis.boxes_shown_closed(ns.hnode, skip(ns.hnode), nr.hnode, skip(nr.hnode), ws, st);
-    if (!nr.cluster() && !ns.cluster()) return false;
-    const Node& e = nr.cluster() ? ns : nr;
-    const Node& c = nr.cluster() ? nr : ns;
-    return m_vis.box_shown_closed(e.seg, skip(e.hnode), c.hnode, skip(c.hnode), ws, st);
+    int pair = l.box_pair - 1;
+    bool closed = false;
+    if (nr.cluster() && ns.cluster()) {
+        closed = m_vis.boxes_shown_closed(ns.hnode, skip(ns.hnode), nr.hnode, skip(nr.hnode), ws, st, pair);
+    } else if (nr.cluster() || ns.cluster()) {
+        const Node& e = nr.cluster() ? ns : nr;
+        const Node& c = nr.cluster() ? nr : ns;
+        closed = m_vis.box_shown_closed(e.seg, skip(e.hnode), c.hnode, skip(c.hnode), ws, st, pair);
+    }
+    l.box_pair = static_cast<uint8_t>(pair + 1);  // (pairs are 0..15)
+    return closed;
 }
 
 // Creates the two halves of element `node` if it has none; returns the first.

@@ -217,12 +217,20 @@ public:
     /// proofs are off (as shown_closed), or when any side's proof leaves a
     /// gap. Counted in stats.queries and stats.slabs per side shown
     /// closed, as any such proof.
+    ///
+    /// first_pair: a pair to prove first, as a proof that failed left it
+    /// (the proof fails on any pair, and a gap found between a link's ends
+    /// is likely still there between their halves), or -1; when this proof
+    /// fails it holds the pair that failed. Pairs are numbered 4 x (side of
+    /// node_a's box; 0 for a segment) + (side of node_b's box), the sides
+    /// as outward_sides gives them. Only the order of the pairs' proofs
+    /// depends on it, never the answer.
     bool box_shown_closed(const Segment& a, int skip_a, int node_b, int skip_b, ExactWorkspace& ws,
-                          VisibilityStats& stats) const;
+                          VisibilityStats& stats, int& first_pair) const;
     /// The same from any point of node_a's box (disjoint from node_b's):
     /// one proof per pair of sides that face each other.
     bool boxes_shown_closed(int node_a, int skip_a, int node_b, int skip_b, ExactWorkspace& ws,
-                            VisibilityStats& stats) const;
+                            VisibilityStats& stats, int& first_pair) const;
 
 private:
     std::optional<TransmittanceResult> transmittance_between(const Segment& sa, const Segment& sb, int skip_a,
@@ -239,9 +247,10 @@ private:
                                           bool slabs_only = false) const;
 
     /// box_closure.cpp: every line from one of `from` to the box `to`
-    /// (widened already) shown closed, side by side.
+    /// (widened already) shown closed, side by side (first_pair: as
+    /// box_shown_closed's).
     bool sides_shown_closed(const Segment* from, int n_from, SkipRange skip_from, const Box& to, SkipRange skip_to,
-                            ExactWorkspace& ws, VisibilityStats& stats) const;
+                            ExactWorkspace& ws, VisibilityStats& stats, int& first_pair) const;
 
     const Hierarchy* m_hierarchy;
     const ClusterTables* m_tables;

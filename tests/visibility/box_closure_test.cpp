@@ -128,7 +128,7 @@ TEST_CASE("box closure: a box shown closed from a segment is closed to every seg
     // closed is checked against exact visibility with the blockers the
     // proof may use, from the element to segments drawn anywhere in the
     // box (its diagonals and 6 random chords) and to up to 2 members.
-    int closed = 0, open = 0, open_exact = 0, checked = 0;
+    int closed = 0, open = 0, open_exact = 0, checked = 0, named = 0;
     for (const double density : {60.0, 100.0}) {
         for (unsigned seed = 1; seed <= 2; ++seed) {
             CAPTURE(density);
@@ -150,7 +150,21 @@ TEST_CASE("box closure: a box shown closed from a segment is closed to every seg
                 const Box& b = h.node(node).box;
                 if (b.lo.y < 2.5 || h.node(node).count > 64 || k % 7 != 0) continue;
                 ++tried;
-                const bool shown = ms.box_shown_closed(a, skip_a, node, node, ws, st);
+                int failed = -1;
+                const bool shown = ms.box_shown_closed(a, skip_a, node, node, ws, st, failed);
+                // Which pair is proven first changes no answer; a proof that
+                // fails names its pair, which fails again when proven first.
+                for (int first = 0; first < 4; ++first) {
+                    int hint = first;
+                    CHECK(ms.box_shown_closed(a, skip_a, node, node, ws, st, hint) == shown);
+                }
+                if (!shown && failed >= 0) {
+                    ++named;
+                    CHECK(failed < 4);
+                    int again = failed;
+                    CHECK_FALSE(ms.box_shown_closed(a, skip_a, node, node, ws, st, again));
+                    CHECK(again == failed);
+                }
                 const std::vector<Segment> blockers = blockers_outside(h, segs, 0, -1, node);
                 if (!shown) {
                     ++open;
@@ -181,6 +195,7 @@ TEST_CASE("box closure: a box shown closed from a segment is closed to every seg
     CHECK(closed >= 20);
     CHECK(checked >= 100);
     CHECK(open_exact >= 5);  // boxes that are open are not shown closed
+    CHECK(named >= 5);        // failed proofs that named their pair (others found no facing side)
 }
 
 TEST_CASE("box closure: two boxes shown closed are closed between any segments inside them; none when they meet") {
@@ -206,7 +221,20 @@ TEST_CASE("box closure: two boxes shown closed are closed between any segments i
     for (size_t i = 0; i < 4; ++i)
         for (size_t j = 0; j < high.size(); j += high.size() / 40) {
             const int A = low[i], B = high[j];
-            if (!ms.boxes_shown_closed(A, A, B, B, ws, st)) continue;
+            int failed = -1;
+            const bool shown = ms.boxes_shown_closed(A, A, B, B, ws, st, failed);
+            for (int first = 0; first < 16; ++first) {  // any pair first: the same answer
+                int hint = first;
+                CHECK(ms.boxes_shown_closed(A, A, B, B, ws, st, hint) == shown);
+            }
+            if (!shown) {
+                if (failed >= 0) {  // (none when no pair faces)
+                    int again = failed;
+                    CHECK_FALSE(ms.boxes_shown_closed(A, A, B, B, ws, st, again));
+                    CHECK(again == failed);
+                }
+                continue;
+            }
             ++closed;
             std::vector<Segment> blockers;
             for (size_t s = 0; s < segs.size(); ++s)
@@ -227,9 +255,11 @@ TEST_CASE("box closure: two boxes shown closed are closed between any segments i
     CHECK(closed >= 5);
     CHECK(checked >= 50);
     // A node and itself, or its parent: the boxes meet, nothing is claimed.
-    CHECK_FALSE(ms.boxes_shown_closed(high[0], high[0], high[0], high[0], ws, st));
-    CHECK_FALSE(ms.boxes_shown_closed(high[0], high[0], h.node(high[0]).parent, h.node(high[0]).parent, ws, st));
+    int none = -1;
+    CHECK_FALSE(ms.boxes_shown_closed(high[0], high[0], high[0], high[0], ws, st, none));
+    CHECK_FALSE(ms.boxes_shown_closed(high[0], high[0], h.node(high[0]).parent, h.node(high[0]).parent, ws, st, none));
     // A segment crossing a box is not shown closed to it.
     const Box& b = h.node(high[0]).box;
-    CHECK_FALSE(ms.box_shown_closed(Segment{b.lo, b.hi}, high[0], high[0], high[0], ws, st));
+    CHECK_FALSE(ms.box_shown_closed(Segment{b.lo, b.hi}, high[0], high[0], high[0], ws, st, none));
+    CHECK(none == -1);  // no pair was proven
 }
