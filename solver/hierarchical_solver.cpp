@@ -8,6 +8,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstddef>
+#include <cstring>
 #include <cmath>
 #include <future>
 #include <limits>
@@ -1002,6 +1003,20 @@ void HierarchicalSolver::build_tree() {
             sides += (side == 0 ? m_scene.segments[s].lit_left : m_scene.segments[s].lit_right) ||
                      m_visible_sink[2 * s + static_cast<size_t>(side)];
     m_nodes.reserve(hn.size() + 2 * sides);
+    {
+        // The pages the breadth-first pass below fills (a node per cluster
+        // and per side: 770 MB at 10^6 segments) are first touched here on
+        // every thread, so that the kernel zeroes them side by side rather
+        // than fault by fault on one thread. Raw storage, bytes only: the
+        // pass constructs every node in it.
+        unsigned char* const raw = reinterpret_cast<unsigned char*>(m_nodes.data());
+        const size_t bytes = (hn.size() + sides) * sizeof(Node);
+        const long T = m_threads;
+#pragma omp parallel for num_threads(m_threads) schedule(static) if (bytes >= (size_t{64} << 20))
+        for (long t = 0; t < T; ++t)
+            std::memset(raw + bytes * static_cast<size_t>(t) / static_cast<size_t>(T), 0,
+                        bytes * static_cast<size_t>(t + 1) / static_cast<size_t>(T) - bytes * static_cast<size_t>(t) / static_cast<size_t>(T));
+    }
     m_nodes.push_back({});
     m_root = 0;
     queue.push_back({m_hierarchy.root(), 0});
