@@ -1,6 +1,7 @@
 #include "engine/scene.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cerrno>
 #include <cmath>
 #include <cstdint>
@@ -423,15 +424,42 @@ public:
 
     /// The first s (SPEC order) with a later t that lies on it, and the
     /// first such t; nothing if no segment lies on another.
+    ///
+    /// The segments in blocks, on every thread: each block stops at its
+    /// first s with a partner, and a block is skipped once a block before
+    /// it has one; the lowest block with one holds the answer, the same as
+    /// one thread's search in order (a 10^6-segment forest: 2.3 s of its
+    /// 8 s load on one thread).
     std::optional<std::pair<size_t, size_t>> first() const {
-        std::vector<int32_t> stack;
-        for (size_t s = 0; s < m_segments.size(); ++s) {
-            size_t partner = m_segments.size();
-            visit_candidates(s, stack, [&](size_t t) {
-                if (t > s && t < partner && lies_on(m_segments[s], m_segments[t])) partner = t;
-            });
-            if (partner < m_segments.size()) return std::pair{s, partner};
+        const size_t n = m_segments.size();
+        constexpr size_t block = 4096;
+        const long blocks = static_cast<long>((n + block - 1) / block);
+        std::vector<std::pair<size_t, size_t>> found(static_cast<size_t>(blocks), {n, n});
+        std::atomic<long> lowest{blocks};  // the lowest block known to hold an s with a partner
+#pragma omp parallel if (blocks > 1)
+        {
+            std::vector<int32_t> stack;
+#pragma omp for schedule(dynamic, 1)
+            for (long b = 0; b < blocks; ++b) {
+                if (b > lowest.load(std::memory_order_relaxed)) continue;
+                const size_t end = std::min(n, static_cast<size_t>(b + 1) * block);
+                for (size_t s = static_cast<size_t>(b) * block; s < end; ++s) {
+                    size_t partner = n;
+                    visit_candidates(s, stack, [&](size_t t) {
+                        if (t > s && t < partner && lies_on(m_segments[s], m_segments[t])) partner = t;
+                    });
+                    if (partner < n) {
+                        found[static_cast<size_t>(b)] = {s, partner};
+                        long seen = lowest.load();
+                        while (b < seen && !lowest.compare_exchange_weak(seen, b)) {
+                        }
+                        break;
+                    }
+                }
+            }
         }
+        for (const auto& f : found)
+            if (f.first < n) return f;
         return std::nullopt;
     }
 

@@ -402,6 +402,31 @@ TEST_CASE("overlap: short pieces on a long wall, and touching its ends") {
     }
 }
 
+TEST_CASE("overlap: among thousands of segments, searched in blocks on several threads, the first is named") {
+    // The search runs in blocks of 4096 segments side by side (OverlapFinder::
+    // first): wherever the overlaps lie, the earliest segment with a later
+    // one on it is named, as the search in order names it.
+    std::vector<Segment> grid;  // short sticks, none on another's line
+    for (int k = 0; k < 13000; ++k) {
+        const double x = (k % 130) * 2.0, y = (k / 130) * 2.0;
+        grid.push_back({{x, y}, {x + 1.0, y + 0.3 + 0.001 * (k % 7)}});
+    }
+    const auto on = [&](size_t s) {  // a piece lying on the middle of segment s
+        const Segment& g = grid[s];
+        return Segment{lerp(g.a, g.b, 0.25), lerp(g.a, g.b, 0.75)};
+    };
+    CHECK_FALSE(check_overlaps_as_oracle(grid));
+    for (const std::vector<std::pair<size_t, size_t>> plants :
+         {std::vector<std::pair<size_t, size_t>>{{12100, 12900}},                     // the last block alone
+          std::vector<std::pair<size_t, size_t>>{{9000, 12800}, {5000, 12900}},       // two blocks: the earlier
+          std::vector<std::pair<size_t, size_t>>{{4095, 12000}, {4096, 4097}, {100, 8200}}}) {
+        std::vector<Segment> segs = grid;
+        for (const auto& [s, t] : plants) segs[t] = on(s);
+        CAPTURE(plants.size());
+        CHECK(check_overlaps_as_oracle(segs));
+    }
+}
+
 TEST_CASE("overlap: a straight polyline is fine, one folding back on itself is not") {
     // Many collinear vertices in one surface: consecutive segments meet end
     // to end. Then the last point goes back over the one before.
