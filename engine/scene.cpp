@@ -1071,6 +1071,7 @@ private:
         std::unordered_map<std::string, size_t> material_index;
         for (size_t m = 0; m < scene.materials.size(); ++m) material_index.emplace(scene.materials[m].name, m);
         std::unordered_map<std::string, size_t> seen_names;
+        seen_names.reserve(surfaces.size());  // (no rehash of 10^6 names as they come)
 
         for (size_t i = 0; i < surfaces.size(); ++i) {
             const std::string path = index_path("surfaces", i);
