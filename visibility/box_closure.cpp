@@ -42,7 +42,7 @@ bool boxes_meet(const Box& a, const Box& b) {
 // has nothing to block. The pair first_pair first: on the 10^6 forest at
 // eps 10 (`scripts/make-scene 1000000 --seed 1 --density 30`), 97 000
 // proofs failed, a third of them at their second or third pair, after 3.8
-// thread-seconds spent showing the pairs before it closed (11.5 on the
+// thread-seconds spent showing the pairs before them closed (11.5 on the
 // pairs that failed); the pair that failed for a link mostly fails again
 // for its children (their ends are halves of its ends).
 bool MultiscaleVisibility::sides_shown_closed(const Segment* from, int n_from, SkipRange skip_from, const Box& to,
