@@ -416,7 +416,7 @@ TEST_CASE("overlap: among thousands of segments, searched in blocks on several t
         return Segment{lerp(g.a, g.b, 0.25), lerp(g.a, g.b, 0.75)};
     };
     CHECK_FALSE(check_overlaps_as_oracle(grid));
-    for (const std::vector<std::pair<size_t, size_t>> plants :
+    for (const std::vector<std::pair<size_t, size_t>>& plants :
          {std::vector<std::pair<size_t, size_t>>{{12100, 12900}},                     // the last block alone
           std::vector<std::pair<size_t, size_t>>{{9000, 12800}, {5000, 12900}},       // two blocks: the earlier
           std::vector<std::pair<size_t, size_t>>{{4095, 12000}, {4096, 4097}, {100, 8200}}}) {
