@@ -1012,10 +1012,9 @@ void HierarchicalSolver::build_tree() {
         unsigned char* const raw = reinterpret_cast<unsigned char*>(m_nodes.data());
         const size_t bytes = (hn.size() + sides) * sizeof(Node);
         const long T = m_threads;
+        const auto cut = [&](long t) { return bytes * static_cast<size_t>(t) / static_cast<size_t>(T); };  // slice t's start
 #pragma omp parallel for num_threads(m_threads) schedule(static) if (bytes >= (size_t{64} << 20))
-        for (long t = 0; t < T; ++t)
-            std::memset(raw + bytes * static_cast<size_t>(t) / static_cast<size_t>(T), 0,
-                        bytes * static_cast<size_t>(t + 1) / static_cast<size_t>(T) - bytes * static_cast<size_t>(t) / static_cast<size_t>(T));
+        for (long t = 0; t < T; ++t) std::memset(raw + cut(t), 0, cut(t + 1) - cut(t));
     }
     m_nodes.push_back({});
     m_root = 0;
