@@ -146,7 +146,10 @@
 ///    out); shown so, the link is dropped whole, exactly, where its pieces
 ///    would each have been split and asked. A lamp's links to a forest
 ///    hundreds of layers deep were split on their geometry down to clusters
-///    of a few sticks, each then shown closed on its own.
+///    of a few sticks, each then shown closed on its own. The proof may
+///    also leave free lines whose bound (the proof's bands) carries at most
+///    a tenth of the bar (box_proof_share): the link is dropped with that
+///    error, as a deferred link keeps its own.
 ///    stats.visibility.boxed counts the links dropped so.
 ///  - Solve: per channel, the matrix-free operator on the element leaves:
 ///    pull (means up the element trees, exitance tables up the clusters),

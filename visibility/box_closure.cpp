@@ -45,9 +45,13 @@ bool boxes_meet(const Box& a, const Box& b) {
 // thread-seconds spent showing the pairs before them closed (11.5 on the
 // pairs that failed); the pair that failed for a link mostly fails again
 // for its children (their ends are halves of its ends).
+// With a budget, each pair's slabs may leave free lines as long as the
+// bands' upper bounds on them (opaque_band.h: at least the pair's exchange,
+// L F) add up to at most the budget over the pairs; each pair is asked
+// within what the pairs before it left.
 bool MultiscaleVisibility::sides_shown_closed(const Segment* from, int n_from, SkipRange skip_from, const Box& to,
                                               SkipRange skip_to, ExactWorkspace& ws, VisibilityStats& stats,
-                                              int& first_pair) const {
+                                              int& first_pair, double budget) const {
     const std::array<Segment, 4> sides = outward_sides(to);  // (to: widened already)
     const int pairs = 4 * n_from;
     const int first = first_pair >= 0 && first_pair < pairs ? first_pair : 0;
@@ -59,17 +63,25 @@ bool MultiscaleVisibility::sides_shown_closed(const Segment* from, int n_from, S
         const Segment& t = sides[static_cast<size_t>(pair % 4)];
         if (!clip_to_lit_halfplanes(f, t)) continue;
         any = true;
-        const MultiscaleResult r = form_factor_skipping(f, t, skip_from, skip_to, 0, GammaRule::Bound, ws, stats, true);
-        if (!(r.F == 0 && r.error_bound == 0)) {
+        // (form_factor_skipping's F is per unit length of f; with a tolerance
+        // eps its bands stop past an exchange of 2 eps L, and a bound
+        // within that comes back as F = error_bound = half of it.)
+        const double L = f.length();
+        const double eps = budget > 0 ? budget / (2 * L) : 0.0;
+        const MultiscaleResult r = form_factor_skipping(f, t, skip_from, skip_to, eps, GammaRule::Bound, ws, stats, true);
+        if (r.F == 0 && r.error_bound == 0) continue;
+        const double used = L * (r.F + r.error_bound);  // the bound on the pair's exchange
+        if (!(budget > 0 && used <= budget)) {          // (NaN or infinity: not shown)
             first_pair = pair;
             return false;
         }
+        budget -= used;
     }
     return any;
 }
 
 bool MultiscaleVisibility::box_shown_closed(const Segment& a, int skip_a, int node_b, int skip_b, ExactWorkspace& ws,
-                                            VisibilityStats& stats, int& first_pair) const {
+                                            VisibilityStats& stats, int& first_pair, double budget) const {
     if (!(m_layers_per_depth > 0) || m_min_pieces_to_prove_closed == std::numeric_limits<size_t>::max()) return false;
     const ClusterNode& B = m_hierarchy->node(node_b);
     if (B.box.empty()) return false;
@@ -78,11 +90,11 @@ bool MultiscaleVisibility::box_shown_closed(const Segment& a, int skip_a, int no
     const ClusterNode& SA = m_hierarchy->node(skip_a);
     const ClusterNode& SB = m_hierarchy->node(skip_b);
     return sides_shown_closed(&a, 1, SkipRange{SA.first, SA.count}, to, SkipRange{SB.first, SB.count}, ws, stats,
-                              first_pair);
+                              first_pair, budget);
 }
 
 bool MultiscaleVisibility::boxes_shown_closed(int node_a, int skip_a, int node_b, int skip_b, ExactWorkspace& ws,
-                                              VisibilityStats& stats, int& first_pair) const {
+                                              VisibilityStats& stats, int& first_pair, double budget) const {
     if (!(m_layers_per_depth > 0) || m_min_pieces_to_prove_closed == std::numeric_limits<size_t>::max()) return false;
     const ClusterNode& A = m_hierarchy->node(node_a);
     const ClusterNode& B = m_hierarchy->node(node_b);
@@ -93,7 +105,7 @@ bool MultiscaleVisibility::boxes_shown_closed(int node_a, int skip_a, int node_b
     const ClusterNode& SA = m_hierarchy->node(skip_a);
     const ClusterNode& SB = m_hierarchy->node(skip_b);
     return sides_shown_closed(from.data(), 4, SkipRange{SA.first, SA.count}, to, SkipRange{SB.first, SB.count}, ws,
-                              stats, first_pair);
+                              stats, first_pair, budget);
 }
 
 }  // namespace flatrad

@@ -31,6 +31,12 @@
 /// three slabs near the narrower end); the pair is closed only if all of
 /// them are. A pair whose ends do not face each other (no line from lit
 /// side to lit side) has no lines to block.
+///
+/// With a budget, the same cover bounds what passes: every free line from
+/// the sender to a point of B is free up to the side it enters by, so the
+/// light entering B (so reaching anything inside it) is at most the
+/// sender's radiosity times the sum over the pairs of their exchanges, each
+/// at most its bands' upper bound.
 #include <array>
 
 #include "engine/geometry.h"

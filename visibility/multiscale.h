@@ -225,12 +225,19 @@ public:
     /// node_a's box; 0 for a segment) + (side of node_b's box), the sides
     /// as outward_sides gives them. Only the order of the pairs' proofs
     /// depends on it, never the answer.
+    ///
+    /// budget: with 0, a proof of closure. Above 0, also true when the
+    /// lines are shown closed but for an exchange of at most `budget` (L F,
+    /// the measure of the free lines over 2, summed over the pairs: an upper
+    /// bound from the slabs' bands, opaque_band.h), which bounds the
+    /// exchange between a (or node_a's box) and everything inside node_b's
+    /// box (box_closure.h). For a caller that may leave that much out.
     bool box_shown_closed(const Segment& a, int skip_a, int node_b, int skip_b, ExactWorkspace& ws,
-                          VisibilityStats& stats, int& first_pair) const;
+                          VisibilityStats& stats, int& first_pair, double budget = 0) const;
     /// The same from any point of node_a's box (disjoint from node_b's):
     /// one proof per pair of sides that face each other.
     bool boxes_shown_closed(int node_a, int skip_a, int node_b, int skip_b, ExactWorkspace& ws,
-                            VisibilityStats& stats, int& first_pair) const;
+                            VisibilityStats& stats, int& first_pair, double budget = 0) const;
 
 private:
     std::optional<TransmittanceResult> transmittance_between(const Segment& sa, const Segment& sb, int skip_a,
@@ -250,7 +257,7 @@ private:
     /// (widened already) shown closed, side by side (first_pair: as
     /// box_shown_closed's).
     bool sides_shown_closed(const Segment* from, int n_from, SkipRange skip_from, const Box& to, SkipRange skip_to,
-                            ExactWorkspace& ws, VisibilityStats& stats, int& first_pair) const;
+                            ExactWorkspace& ws, VisibilityStats& stats, int& first_pair, double budget = 0) const;
 
     const Hierarchy* m_hierarchy;
     const ClusterTables* m_tables;

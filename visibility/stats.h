@@ -19,7 +19,7 @@ struct VisibilityStats {
     long slabs = 0;             ///< of opaque and banded: settled by a long shaft's slabs alone (multiscale.h)
     long screens = 0;           ///< closure screens shown closed (closure_screen.h, MultiscaleVisibility::shown_closed)
     long screened = 0;          ///< queries answered by a closure screen instead (counted by the caller)
-    long boxed = 0;             ///< links dropped whole: every line between their ends' boxes shown blocked (box_closure.h; counted by the caller)
+    long boxed = 0;             ///< links dropped whole: every line between their ends' boxes shown blocked, or all but lines the caller may leave out (box_closure.h; counted by the caller)
 
     VisibilityStats& operator+=(const VisibilityStats& o) {
         queries += o.queries;
