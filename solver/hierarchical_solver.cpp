@@ -176,17 +176,19 @@ constexpr double closure_screen_spread = 0.04;
 constexpr double box_proof_below = 1e-10;
 // Such a proof may also leave free lines whose exchange, bounded by its
 // bands (box_closure.h), carries at most this share of the bar (the
-// deferred links' share, deferred_share, below): the link is dropped, and what it
-// leaves out is within that bound. The proofs' narrow gaps (the drift of
-// pieces within a bin, or a sliver of lines past a band's end) then no
-// longer fail a proof and split the link into pieces, each proven again.
-// On the 10^6 forest at eps 10 (one run each, in sequence): the form
-// factors 30.6 s -> 22.4 s (the third round 15.1 -> 9.4 s: box proofs of
-// wall elements tens of units long to clusters 50-200 away, 23 500 -> 14
-// 400 of them, 18.0 -> 9.9 thread-s), the whole solve 58.6 -> 49.6 s; the
-// solution within 9.7e-7 relative L2 of the exact proofs', balance
-// 1.37500e-2 (exact proofs: 1.37496e-2). With share 1e-3 (unresolved_share) the
-// same solution to 1e-15 and the form factors 29.3 s.
+// deferred links' share, deferred_share, below): the link is dropped, and
+// what it leaves out is within that bound. The proofs' narrow gaps (the
+// drift of pieces within a bin, or a sliver of lines past a band's end)
+// then no longer fail a proof and split the link into pieces, each proven
+// again. On the 10^6 forest at eps 10 (two pairs of runs, interleaved):
+// the form factors 31.1 / 31.9 -> 24.7 / 24.4 s, the solve 56.9 / 58.7 ->
+// 49.2 / 49.8 s (with counters: the third round 15.1 -> 9.4 s, its box
+// proofs of wall elements tens of units long to clusters 50-200 away
+// 23 500 -> 14 400, 18.0 -> 9.9 thread-s); the solution within 9.7e-7
+// relative L2 of the exact proofs', balance 1.37500e-2 (exact proofs:
+// 1.37496e-2). With share 1e-3 (unresolved_share): the same solution to
+// 1e-15, form factors 29.3 s against 30.6 s; with share 1, 23.96 s against
+// 23.91 s at 0.1, the solution 1.4e-5 from the exact proofs'.
 constexpr double box_proof_share = 0.1;
 // A link not shown closed whole (its proof left a gap, or none was
 // tried: two elements, or box_closure off) is split on its larger end, not on
@@ -2038,10 +2040,9 @@ bool HierarchicalSolver::behind_closure_screen(int e, const Box& region, ExactWo
 // Whether every line between a link's two ends is shown blocked at once
 // (visibility/box_closure.h), or all but lines carrying at most
 // box_proof_share of `bar` (the link may then be dropped): from an
-// element's lit side, or from anywhere
-// in a cluster's box, to anywhere in the other end's cluster box, the
-// segments of either end's skipped node not counted (link_transmittance's
-// skips). Element pairs are left to their own query. The pair of sides
+// element's lit side, or from anywhere in a cluster's box, to anywhere in
+// the other end's cluster box, the segments of either end's skipped node
+// not counted (link_transmittance's skips). Element pairs are left to their own query. The pair of sides
 // whose proof failed for the link, or for the link it was split from, is
 // proven first (Link::box_pair), and a failure leaves its own there.
 bool HierarchicalSolver::shown_closed_whole(Link& l, double bar, ExactWorkspace& ws, VisibilityStats& st) const {
