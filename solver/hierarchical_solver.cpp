@@ -2042,9 +2042,10 @@ bool HierarchicalSolver::behind_closure_screen(int e, const Box& region, ExactWo
 // box_proof_share of `bar` (the link may then be dropped): from an
 // element's lit side, or from anywhere in a cluster's box, to anywhere in
 // the other end's cluster box, the segments of either end's skipped node
-// not counted (link_transmittance's skips). Element pairs are left to their own query. The pair of sides
-// whose proof failed for the link, or for the link it was split from, is
-// proven first (Link::box_pair), and a failure leaves its own there.
+// not counted (link_transmittance's skips). Element pairs are left to
+// their own query. The pair of sides whose proof failed for the link, or
+// for the link it was split from, is proven first (Link::box_pair), and a
+// failure leaves its own there.
 bool HierarchicalSolver::shown_closed_whole(Link& l, double bar, ExactWorkspace& ws, VisibilityStats& st) const {
     const Node& nr = m_nodes[static_cast<size_t>(l.r)];
     const Node& ns = m_nodes[static_cast<size_t>(l.s)];

@@ -76,21 +76,25 @@ std::vector<Segment> inside(const Box& b, int random, std::mt19937_64& rng) {
 // slab proofs a few units up; with `lane`, a lane 0.6 wide clear of sticks
 // from the element's midpoint at 100 degrees, whose boxes stay open; with
 // `slit` > 0 instead, only a slit that wide on either side of that line
-// (no stick comes nearer to it).
+// (no stick comes nearer to it): the line from lane_origin along
+// lane_direction().
+const Vec2 lane_origin{0.1, 0};
+Vec2 lane_direction() { return {std::cos(100 * std::numbers::pi / 180), std::sin(100 * std::numbers::pi / 180)}; }
+
 std::vector<Segment> forest(double density, unsigned seed, bool lane, double slit = 0) {
     std::mt19937_64 rng(seed);
     std::uniform_real_distribution<double> U(0, 1);
     std::vector<Segment> segs{{{0, 0}, {0.2, 0}}};
     const double x0 = -4, x1 = 4.2, y0 = 0.1, y1 = 14;
     const int sticks = static_cast<int>(density * (x1 - x0) * (y1 - y0));
-    const Vec2 dir{std::cos(100 * std::numbers::pi / 180), std::sin(100 * std::numbers::pi / 180)};
+    const Vec2 dir = lane_direction();
     for (int k = 0; k < sticks; ++k) {
         const double len = 0.05 + 0.1 * U(rng), ang = std::numbers::pi * U(rng);
         const Vec2 c{x0 + (x1 - x0) * U(rng), y0 + 0.1 + (y1 - y0 - 0.2) * U(rng)};
         const Vec2 d{0.5 * len * std::cos(ang), 0.5 * len * std::sin(ang)};
-        if (lane && std::abs(cross(dir, c - Vec2{0.1, 0})) < 0.3 + 0.5 * len) continue;
+        if (lane && std::abs(cross(dir, c - lane_origin)) < 0.3 + 0.5 * len) continue;
         if (slit > 0) {
-            const double dp = cross(dir, c - d - Vec2{0.1, 0}), dq = cross(dir, c + d - Vec2{0.1, 0});
+            const double dp = cross(dir, c - d - lane_origin), dq = cross(dir, c + d - lane_origin);
             if ((dp > 0) != (dq > 0) || std::min(std::abs(dp), std::abs(dq)) < slit) continue;
         }
         segs.push_back({c - d, c + d});
@@ -314,8 +318,7 @@ TEST_CASE("box closure within a budget: what the proof leaves free is within it,
                 const int node = static_cast<int>(k);
                 const Box& b = f.h.node(node).box;
                 // (Every node the slit's line crosses, and a fifth of the others.)
-                const Vec2 dir{std::cos(100 * std::numbers::pi / 180), std::sin(100 * std::numbers::pi / 180)};
-                const bool on_slit = segment_meets_box(Vec2{0.1, 0}, Vec2{0.1, 0} + 20.0 * dir, b);
+                const bool on_slit = segment_meets_box(lane_origin, lane_origin + 20.0 * lane_direction(), b);
                 if (b.lo.y < 2.5 || f.h.node(node).count > 64 || (k % 5 != 0 && !on_slit)) continue;
                 ++tried;
                 const std::vector<Segment> blockers = blockers_outside(f.h, f.segs, 0, -1, node);
