@@ -897,6 +897,14 @@ private:
     bool m_operator_changed = true;
     long m_setups_kept = 0;
     long m_cluster_links = 0;
+    // stats.phases: the stages ended so far, and when the current one began.
+    std::vector<Phase> m_phases;
+    Clock::time_point m_phase_start = m_t_start;
+    void end_phase(std::string name) {
+        const auto now = Clock::now();
+        m_phases.push_back({std::move(name), std::chrono::duration<double>(now - m_phase_start).count()});
+        m_phase_start = now;
+    }
 };
 
 void HierarchicalSolver::refuse_closed_white() const {
@@ -1136,7 +1144,9 @@ void HierarchicalSolver::build_tree() {
         }
     }
     mark_chains();
+    end_phase("tree");
     self_occlusion();
+    end_phase("self occlusion");
 }
 
 // Occlusion inside clusters (solver/self_occlusion.h). Per table cluster,
@@ -3346,6 +3356,7 @@ std::vector<double> HierarchicalSolver::landed_fraction() const {
 }
 
 Solution HierarchicalSolver::run() {
+    end_phase("set-up");
     refuse_closed_white();
     build_tree();
     collect_leaves();
@@ -3370,6 +3381,7 @@ Solution HierarchicalSolver::run() {
         } else {
             refine(guess);
         }
+        end_phase("refine 1");
         // Intermediate solves stop at a looser residual; the last is taken
         // on to gmres_tolerance (see intermediate_accuracy).
         double rho_max = 0;
@@ -3380,6 +3392,7 @@ Solution HierarchicalSolver::run() {
                                  : gmres_tolerance;
         double last_tolerance = m_opt.max_passes > 1 ? loose : gmres_tolerance;
         solve(last_tolerance);
+        end_phase("solve 1");
         m_passes = 1;
         for (int pass = 1; pass < m_opt.max_passes; ++pass) {
             // (The leaves and operator nodes are the ones solve() collected:
@@ -3389,14 +3402,20 @@ Solution HierarchicalSolver::run() {
                 for (int c = 0; c < m_C; ++c)
                     bmax[i] = std::max(bmax[i], m_B[static_cast<size_t>(c)][static_cast<size_t>(m_leaves[i])]);
             progress(fmt::format("refining (pass {})", pass + 1), -1);
-            if (!refine(bmax)) break;
+            const bool changed = refine(bmax);
+            end_phase(fmt::format("refine {}", pass + 1));
+            if (!changed) break;
             last_tolerance = pass + 1 < m_opt.max_passes ? loose : gmres_tolerance;
             solve(last_tolerance);
+            end_phase(fmt::format("solve {}", pass + 1));
             ++m_passes;
         }
         // The links are final: the last values to full accuracy (a
         // solve again, also for the links the last round dropped).
-        if (last_tolerance > gmres_tolerance) solve(gmres_tolerance);
+        if (last_tolerance > gmres_tolerance) {
+            solve(gmres_tolerance);
+            end_phase("solve final");
+        }
     } else {
         collect_leaves();  // nothing emits: B = 0 everywhere, no link needed
         m_left_out = static_cast<long>(m_scene.patches.size());
@@ -3491,6 +3510,8 @@ Solution HierarchicalSolver::run() {
     sol.stats.residual = m_residual;
     sol.stats.threads = m_threads;
     sol.stats.visibility = m_stats;
+    end_phase("result");
+    sol.stats.phases = std::move(m_phases);
     sol.stats.time_s = seconds_since(m_t_start);
     return sol;
 }

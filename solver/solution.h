@@ -36,8 +36,21 @@ struct Totals {
     }
 };
 
+/// One stage of a run and its wall time.
+struct Phase {
+    std::string name;
+    double time_s = 0;
+};
+
 struct SolveStats {
     double time_s = 0;
+    /// The run's stages in order with their wall times, which add up to
+    /// time_s but for bookkeeping between them. Hierarchical: "set-up"
+    /// (hierarchy, connectivity, rooms), "tree" (nodes, tables), "self
+    /// occlusion", then "refine 1", "solve 1", "refine 2", ... and "solve
+    /// final" when the last solve is a separate one, and "result". Exact:
+    /// "form factors", "solve", "result".
+    std::vector<Phase> phases;
     double form_factor_time_s = 0;
     double linear_solve_time_s = 0;
     long elements = 0;

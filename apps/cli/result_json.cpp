@@ -67,6 +67,9 @@ void result_tail(ordered_json& j, const Solution& solution) {
     stats["threads"] = s.threads;
     stats["form_factor_time_s"] = s.form_factor_time_s;
     stats["linear_solve_time_s"] = s.linear_solve_time_s;
+    ordered_json phases = ordered_json::array();
+    for (const Phase& ph : s.phases) phases.push_back({{"name", ph.name}, {"time_s", ph.time_s}});
+    stats["phases"] = std::move(phases);
     stats["visibility"] = visibility_stats_json(s.visibility);
     j["stats"] = std::move(stats);
 }

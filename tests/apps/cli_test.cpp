@@ -255,8 +255,12 @@ TEST_CASE("cli: solve writes the SPEC result file to stdout") {
     CHECK(result["totals"]["emitted"][0].get<double>() == doctest::Approx(8.0));
     CHECK(result["totals"]["balance"][0].get<double>() < 1e-9);
     for (const char* key : {"time_s", "elements", "links", "iterations", "residual", "threads",
-                            "form_factor_time_s", "linear_solve_time_s", "visibility"})
+                            "form_factor_time_s", "linear_solve_time_s", "phases", "visibility"})
         CHECK_MESSAGE(result["stats"].contains(key), key);
+    REQUIRE(result["stats"]["phases"].is_array());
+    REQUIRE(!result["stats"]["phases"].empty());
+    CHECK(result["stats"]["phases"].front()["name"] == "form factors");  // this run is exact
+    CHECK(result["stats"]["phases"].back()["name"] == "result");
     CHECK(result["stats"]["elements"] == 18);
     for (const char* key : {"queries", "clusters_visited", "approximated"})
         CHECK_MESSAGE(result["stats"]["visibility"].contains(key), key);
