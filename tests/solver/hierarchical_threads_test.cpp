@@ -87,3 +87,16 @@ TEST_CASE("hierarchical threads: the operator's passes split over subtrees give 
     // than the 8192 nodes from which it is split.)
     CHECK(one.stats.elements > 8192);
 }
+
+TEST_CASE("hierarchical threads: the tree's bottom-up passes over levels give one thread's sums") {
+    // build_tree and self_occlusion gather each node from its children a
+    // level at a time, levels of 8192 nodes or more on every thread
+    // (HierarchicalSolver::bottom_up): the cones, sensitivities and hidden
+    // flags must not depend on which thread did which node. 24 000 sticks:
+    // the levels near the leaves hold more than 8192 nodes each.
+    const Scene scene = parse_scene(forest_json(24000, 15.5, 15.5, 4), "forest24000.json");
+    HierarchicalOptions o;
+    o.eps = 10;
+    const Solution one = check_thread_independent(scene, o, 1);
+    CHECK(one.stats.elements > 2 * 8192);
+}
