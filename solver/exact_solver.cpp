@@ -198,7 +198,9 @@ Solution solve_exact(const Scene& scene, const ExactSolverOptions& options) {
     sol.stats.visibility = vis;
     // (The form factors' stage includes the mesh and the visibility set-up.)
     const double result_time = seconds_since(t_result);
-    sol.stats.phases = {{"form factors", std::chrono::duration<double>(t_solve - t_start).count()}, {"solve", solve_time}, {"result", result_time}};
+    sol.stats.phases = {{"form factors", std::chrono::duration<double>(t_solve - t_start).count()},
+                        {"solve", solve_time},
+                        {"result", result_time}};
     sol.stats.time_s = seconds_since(t_start);
     return sol;
 }
