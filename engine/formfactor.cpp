@@ -56,7 +56,12 @@ double exchange_wedge(Vec2 o, Vec2 p, Vec2 q) {
         const double c = cross(P, Q);
         return c * c / (lp * lq - pq);
     }();
-    const double S = 2 * num / (lp + lq + lpq);
+    // Sides so short that their lengths underflow to 0 (a denormal's
+    // square is 0) exchange 0 to every digit a double holds (X is at most
+    // the shorter side's length): not 0 / 0.
+    const double den = lp + lq + lpq;
+    if (!(den > 0)) return 0;
+    const double S = 2 * num / den;
     return S / 2;
 }
 

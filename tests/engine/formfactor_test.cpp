@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <random>
 #include <vector>
@@ -111,6 +112,37 @@ TEST_CASE("crossed strings: wedges sharing an endpoint, angles 1e-4 .. pi - 1e-4
         CAPTURE(alpha);
         CHECK(rel_err(form_factor_unoccluded(i, j), ref) <= closed_form_tol);
     }
+}
+
+TEST_CASE("crossed strings: a wedge whose sides' lengths underflow exchanges 0, not NaN") {
+    // The fuzzer's regress_denormal_wedge_nan.json: a lamp's end at (0, 0)
+    // and a wall's end at (0, -4.9e-324), the least denormal away. Clipped
+    // to each other's lit half-planes, the two become a wedge with sides of
+    // a denormal's length, whose squares (and so their norms) are 0: the
+    // crossed strings were 0 / 0. An exchange is at most the shorter
+    // side's length, here 0 to every digit a double holds.
+    const double tiny = std::numeric_limits<double>::denorm_min();
+    const Segment wall{{0, -tiny}, {1, 1}}, lamp_back{{1, 0}, {0, 0}};
+    const auto clipped = clip_to_lit_halfplanes(wall, lamp_back);
+    REQUIRE(clipped);
+    const double X = exchange_crossed_strings(clipped->first, clipped->second);
+    CHECK(std::isfinite(X));
+    CHECK(X == 0);
+    // The unclipped pair as the solvers ask for it, both ways.
+    for (const double F : {form_factor_unoccluded(wall, lamp_back), form_factor_unoccluded(lamp_back, wall)}) {
+        CHECK(std::isfinite(F));
+        CHECK(F >= 0);
+        CHECK(F <= 1);
+    }
+    // The same wedge with sides of 1e-150 (squares 1e-300, still normal
+    // doubles) keeps its exchange: the unit wedge's, scaled (the guard is
+    // for lengths that vanish only).
+    const double h = 1e-150;
+    const Segment w{{0, -h}, {h, 0}}, l{{h, 0}, {0, 0}};
+    const Segment w1{{0, -1}, {1, 0}}, l1{{1, 0}, {0, 0}};
+    const double unit = exchange_crossed_strings(w1, l1);
+    CHECK(unit > 0.5);  // (1 + sqrt 2 - 1) / 2 = 0.707...
+    CHECK(rel_err(exchange_crossed_strings(w, l) / h, unit) <= closed_form_tol);
 }
 
 TEST_CASE("crossed strings: scale invariance 1e-6 .. 1e6 and translation") {
