@@ -677,26 +677,30 @@ private:
     void convex_object_skips(const Connectivity& conn);
     void build_tree();
     void mark_chains();
-    void self_occlusion();
+    void self_occlusion(const std::vector<size_t>& level_start);
     void sensitivity_with_gamma(size_t k);
     void gather_from_children(size_t k);
-    // f(k) for every node k, children before parents, while the nodes are
-    // in breadth-first order as build_tree lays them out (before any
-    // element is split): each level of the tree is then one run of nodes,
-    // done from the deepest up, each level's nodes on every thread. f(k)
-    // may read k's children and write k only.
-    template <class F>
-    void bottom_up(const F& f) {
-        std::vector<size_t> start = {0};  // level d: nodes [start[d], start[d + 1])
-        {
-            std::vector<int32_t> level(m_nodes.size(), 0);
-            for (size_t k = 1; k < m_nodes.size(); ++k) {
-                level[k] = level[static_cast<size_t>(m_nodes[k].parent)] + 1;
-                FLATRAD_ASSERT(level[k] >= level[k - 1], "the nodes are in breadth-first order");
-                if (level[k] != level[k - 1]) start.push_back(k);
-            }
-            start.push_back(m_nodes.size());
+    // The levels of the node tree while the nodes are in breadth-first
+    // order as build_tree lays them out (before any element is split):
+    // level d is then the run of nodes [start[d], start[d + 1]).
+    std::vector<size_t> level_starts() const {
+        std::vector<size_t> start = {0};
+        std::vector<int32_t> level(m_nodes.size(), 0);
+        for (size_t k = 1; k < m_nodes.size(); ++k) {
+            level[k] = level[static_cast<size_t>(m_nodes[k].parent)] + 1;
+            FLATRAD_ASSERT(level[k] >= level[k - 1], "the nodes are in breadth-first order");
+            if (level[k] != level[k - 1]) start.push_back(k);
         }
+        start.push_back(m_nodes.size());
+        return start;
+    }
+    // f(k) for every node k, children before parents: the levels
+    // (level_starts, for the nodes as they are) from the deepest up, each
+    // level's nodes on every thread. f(k) may read k's children and write
+    // k only.
+    template <class F>
+    void bottom_up(const std::vector<size_t>& start, const F& f) {
+        FLATRAD_ASSERT(!start.empty() && start.back() == m_nodes.size(), "levels of the nodes as they are");
         for (size_t d = start.size() - 1; d-- > 0;) {
             const long first = static_cast<long>(start[d]), last = static_cast<long>(start[d + 1]);
 #pragma omp parallel for num_threads(m_threads) schedule(dynamic, 4096) if (last - first >= 8192)
@@ -1138,10 +1142,12 @@ void HierarchicalSolver::build_tree() {
     m_J_slot = m_I_slot;
     // can_send, cones, rooms and sensitivity, children before parents: each
     // node gathers from its children (bottom_up).
-    bottom_up([this](size_t k) { gather_from_children(k); });
+    // (The levels serve self_occlusion too: no node is added in between.)
+    const std::vector<size_t> level_start = level_starts();
+    bottom_up(level_start, [this](size_t k) { gather_from_children(k); });
     mark_chains();
     end_phase("tree");
-    self_occlusion();
+    self_occlusion(level_start);
     end_phase("self occlusion");
 }
 
@@ -1210,7 +1216,7 @@ void HierarchicalSolver::gather_from_children(size_t k) {
 // chains (arcs of a convex loop, lit on the room's side, whose partners
 // lie inside the loop: seen from there, no side hides another, while the
 // view from far along a direction, from outside the loop, would).
-void HierarchicalSolver::self_occlusion() {
+void HierarchicalSolver::self_occlusion(const std::vector<size_t>& level_start) {
     m_gamma_slot.clear();
     m_gamma.clear();
     m_face.clear();
@@ -1311,7 +1317,7 @@ void HierarchicalSolver::self_occlusion() {
     // Children before parents: a table's sensitivity becomes the sum of
     // its children's (final) sensitivities, each times its gamma (at 10^6
     // segments 1.1 s on one thread).
-    bottom_up([this](size_t k) { sensitivity_with_gamma(k); });
+    bottom_up(level_start, [this](size_t k) { sensitivity_with_gamma(k); });
 }
 
 // Node k's sensitivity (a table's) from its children's, each times its gamma,
