@@ -925,7 +925,6 @@ private:
     // next solve keeps that solve's set-up (solve).
     bool m_operator_changed = true;
     long m_setups_kept = 0;
-    long m_cluster_links = 0;
     // stats.phases: the stages ended so far, and when the current one began.
     std::vector<Phase> m_phases;
     Clock::time_point m_phase_start = m_t_start;
@@ -2873,7 +2872,7 @@ void HierarchicalSolver::sort_links() {
 }
 
 // The CSR of links sorted by receiver: each receiver and where its links
-// start; and the count of cluster links.
+// start.
 void HierarchicalSolver::index_receivers() {
     m_receivers.clear();
     m_link_start.clear();
@@ -2883,10 +2882,6 @@ void HierarchicalSolver::index_receivers() {
             m_link_start.push_back(static_cast<int32_t>(k));
         }
     m_link_start.push_back(static_cast<int32_t>(m_links.size()));
-    m_cluster_links = 0;
-    for (const Link& l : m_links)
-        if (m_op[static_cast<size_t>(l.r)].kind == Kind::Cluster || m_op[static_cast<size_t>(l.s)].kind == Kind::Cluster)
-            ++m_cluster_links;
 }
 
 // Which tables the operator keeps samples for (solver/table_array.h): an
@@ -3046,6 +3041,10 @@ void HierarchicalSolver::apply_G(const Eigen::VectorXd& x, Eigen::VectorXd& out,
         double* J_linear = to_table ? m_J.linear(nr.table) : nullptr;
         for (int32_t k = m_link_start[static_cast<size_t>(q)]; k < m_link_start[static_cast<size_t>(q) + 1]; ++k) {
             const Link& l = m_links[static_cast<size_t>(k)];
+            // A link that carries nothing adds +0 (no sender read): the
+            // overlapping faint neighbours' unresolved links and links
+            // shown closed, 41% of the 10^6 forest's.
+            if (l.coef == 0) continue;
             const int32_t t = m_table_of[static_cast<size_t>(l.s)];  // -1: an element sends its mean
             const double v = t < 0 || l.uniform ? m_Bn[static_cast<size_t>(l.s)]
                              : l.s_linear       ? read_linear_part(m_I.linear(t), l.u())
@@ -3371,6 +3370,7 @@ std::vector<double> HierarchicalSolver::landed_fraction() const {
     lam.reset(m_I_slot, m_I_slotted);
     lam.clear();
     for (const Link& l : m_links) {
+        if (l.coef == 0) continue;  // delivers nothing (as in apply_G)
         const Node& r = m_nodes[static_cast<size_t>(l.r)];
         const Node& s = m_nodes[static_cast<size_t>(l.s)];
         const double* S = r.cluster() ? &m_sensitivity[static_cast<size_t>(r.table) * TW] : nullptr;
@@ -3535,7 +3535,10 @@ Solution HierarchicalSolver::run() {
     sol.stats.elements = m_element_leaves;
     sol.stats.links = static_cast<long>(m_links.size());
     sol.stats.patches_left_out = m_left_out;
-    sol.stats.cluster_links = m_cluster_links;
+    // (Counted once here: reads both ends' nodes at random, 0.1 s at 10^6.)
+    sol.stats.cluster_links = std::count_if(m_links.begin(), m_links.end(), [&](const Link& l) {
+        return m_nodes[static_cast<size_t>(l.r)].cluster() || m_nodes[static_cast<size_t>(l.s)].cluster();
+    });
     sol.stats.chain_links = std::count_if(m_links.begin(), m_links.end(), [](const Link& l) { return l.uniform; });
     sol.stats.cluster_tables = m_tables_count;
     sol.stats.sampled_tables = std::max(m_I_slotted, m_J_slotted);
