@@ -217,6 +217,17 @@ bool narrower_at_i(const Segment& ci, const Segment& cj);
 double band_bound(const Segment& ci, const Segment& cj, const Segment* blockers, size_t count,
                   const BandOptions& options, OpaqueBandScratch& scratch);
 
+/// One step of a band section's check (band_bound's, per bin and section):
+/// each item's shadow held at every direction of a bin (held() of its
+/// ends' offsets n . p, n . q, widened by rp h and rq h), written in order
+/// to kept[0, m) when it is not empty and meets `window`; returns m. kept
+/// needs room for count intervals (a dropped shadow's place is written
+/// over). With AVX four items a step, the same shadows bit for bit
+/// (tests/visibility/opaque_band_test.cpp checks it against the obvious
+/// loop, NaN and signed zeros included).
+size_t held_in_window(const OpaqueBandScratch::Item* items, size_t count, Vec2 n, double h, OffsetInterval window,
+                      OffsetInterval* kept);
+
 /// True when the blockers are shown to stop every line from ci to cj
 /// (band_bound with limit 0 and the proof's settings).
 inline bool band_closes_shaft(const Segment& ci, const Segment& cj, const Segment* blockers, size_t count,

@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <random>
 #include <tuple>
@@ -411,6 +412,71 @@ TEST_CASE("opaque band: a section's gaps summed by hops are the sorted sweep's, 
     CHECK(covered > 1000);
     CHECK(stopped > 1000);
     CHECK(many_gaps > 1000);
+}
+
+TEST_CASE("opaque band: a section's held shadows, four at a time, are the obvious loop's, bit for bit") {
+    // The oracle: each item's shadow held over the bin, kept when not empty
+    // and meeting the window, in order (band_bound's step as first written).
+    auto oracle = [](const std::vector<OpaqueBandScratch::Item>& items, Vec2 n, double h, OffsetInterval window) {
+        std::vector<OffsetInterval> kept;
+        for (const auto& e : items) {
+            const OffsetInterval sh = held(n.x * e.p.x + n.y * e.p.y, e.rp * h, n.x * e.q.x + n.y * e.q.y, e.rq * h);
+            if (sh.b > sh.a && sh.b > window.a && sh.a < window.b) kept.push_back(sh);
+        }
+        return kept;
+    };
+    auto same_bits = [](double x, double y) { return std::memcmp(&x, &y, sizeof x) == 0; };
+    std::mt19937_64 rng(23);
+    std::uniform_real_distribution<double> u(-1, 1);
+    const double specials[] = {0.0, -0.0, std::numeric_limits<double>::quiet_NaN(),
+                               std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
+    long compared = 0, with_specials = 0, kept_some = 0, dropped_some = 0;
+    for (int t = 0; t < 5000; ++t) {
+        const int count = t % 13;  // 0 .. 12: whole steps of four and every tail
+        const double angle = 3.2 * u(rng);
+        const Vec2 n{-std::sin(angle), std::cos(angle)};
+        const double h = t % 7 == 0 ? 0.0 : 0.05 * std::abs(u(rng));
+        OffsetInterval window{-0.5 + 0.3 * u(rng), 0.5 + 0.3 * u(rng)};
+        std::vector<OpaqueBandScratch::Item> items;
+        bool special = false;
+        for (int k = 0; k < count; ++k) {
+            OpaqueBandScratch::Item e{{u(rng), u(rng)}, {u(rng), u(rng)}, 0, 0};
+            if (t % 5 == 0) e.q = e.p;  // a point: its held shadow is empty
+            e.rp = norm(e.p);
+            e.rq = norm(e.q);
+            if (t % 11 == 0) {  // NaN, infinities and signed zeros in any field
+                double* field = &e.p.x + static_cast<int>(6 * (0.5 + 0.5 * u(rng))) % 6;
+                *field = specials[static_cast<size_t>(5 * (0.5 + 0.5 * u(rng))) % 5];
+                special = true;
+            }
+            items.push_back(e);
+        }
+        // Shadows that end exactly where the window starts, or start where
+        // it ends: not kept (they meet it in a point).
+        if (count > 0 && t % 3 != 0) {
+            const auto& e = items[static_cast<size_t>(t) % items.size()];
+            const OffsetInterval sh = held(n.x * e.p.x + n.y * e.p.y, e.rp * h, n.x * e.q.x + n.y * e.q.y, e.rq * h);
+            if (t % 3 == 1) window.b = sh.a;
+            else window.a = sh.b;
+        }
+        const std::vector<OffsetInterval> want = oracle(items, n, h, window);
+        std::vector<OffsetInterval> got(static_cast<size_t>(count) + 1, OffsetInterval{7, 7});
+        const size_t m = held_in_window(items.data(), items.size(), n, h, window, got.data());
+        REQUIRE(m == want.size());
+        for (size_t k = 0; k < m; ++k) {
+            CHECK(same_bits(got[k].a, want[k].a));
+            CHECK(same_bits(got[k].b, want[k].b));
+        }
+        ++compared;
+        with_specials += special;
+        kept_some += m > 0;
+        dropped_some += m < items.size();
+    }
+    CHECK(compared == 5000);
+    // Each case was met: specials, shadows kept, shadows dropped.
+    CHECK(with_specials > 100);
+    CHECK(kept_some > 1000);
+    CHECK(dropped_some > 1000);
 }
 
 TEST_CASE("opaque band: the runs found bucket by bucket give the whole sort's answers, bit for bit") {
