@@ -3535,16 +3535,19 @@ Solution HierarchicalSolver::run() {
     sol.stats.elements = m_element_leaves;
     sol.stats.links = static_cast<long>(m_links.size());
     sol.stats.patches_left_out = m_left_out;
-    // (Counted once here: reads both ends' nodes at random, 0.1 s at 10^6.)
-    sol.stats.cluster_links = std::count_if(m_links.begin(), m_links.end(), [&](const Link& l) {
-        return m_nodes[static_cast<size_t>(l.r)].cluster() || m_nodes[static_cast<size_t>(l.s)].cluster();
-    });
-    sol.stats.chain_links = std::count_if(m_links.begin(), m_links.end(), [](const Link& l) { return l.uniform; });
+    // The links by kind, in one pass (cluster links once here, not on
+    // every solve: both ends' nodes read at random; 0.045 s for the 3.5
+    // million links of the 10^6 forest).
+    sol.stats.cluster_links = sol.stats.chain_links = sol.stats.unqueried_links = 0;
+    for (const Link& l : m_links) {
+        sol.stats.cluster_links += m_nodes[static_cast<size_t>(l.r)].cluster() || m_nodes[static_cast<size_t>(l.s)].cluster();
+        sol.stats.chain_links += l.uniform;
+        sol.stats.unqueried_links += l.vis_pending;
+    }
     sol.stats.cluster_tables = m_tables_count;
     sol.stats.sampled_tables = std::max(m_I_slotted, m_J_slotted);
     sol.stats.independent_parts = m_part_count;
     sol.stats.iterations = m_iterations;
-    sol.stats.unqueried_links = std::count_if(m_links.begin(), m_links.end(), [](const Link& l) { return l.vis_pending; });
     sol.stats.passes = m_passes;
     sol.stats.setups_kept = m_setups_kept;
     sol.stats.emission_first = m_emission_first && m_passes > 0;
