@@ -4,7 +4,7 @@
 #include <cmath>
 #include <limits>
 
-#if defined(__SSE2__)
+#if defined(__AVX__)
 #include <immintrin.h>
 #endif
 
@@ -181,15 +181,7 @@ void bucket_band(const Band& band, OpaqueBandScratch::Buckets& bb, double c_lo, 
         for (int sct = a; sct <= b; ++sct) {
             const Vec2 O{band.t0, band.ya + (sct + 0.5) * band.w};  // section sct's midpoint (uncovered's)
             const Vec2 p = ends[2 * item] - O, q = ends[2 * item + 1] - O;
-#if defined(__SSE2__)
-            // (Both roots in one instruction, the same as norm's: the items
-            // wait on them, and most pieces fall in one or two sections.)
-            double roots[2];
-            _mm_storeu_pd(roots, _mm_sqrt_pd(_mm_set_pd(norm_squared(q), norm_squared(p))));
-            items[fill[static_cast<size_t>(sct)]++] = {p, q, roots[0], roots[1]};
-#else
             items[fill[static_cast<size_t>(sct)]++] = {p, q, norm(p), norm(q)};
-#endif
         }
     }
 }
