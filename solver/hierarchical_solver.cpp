@@ -2408,7 +2408,10 @@ LinkError HierarchicalSolver::link_error(const Link& l, const std::vector<double
     else
         rel_r = r.radius / dist;
     if (s.cluster())
-        rel_s = 2 * s.radius / dist + layered(s, l.sbin()) + v_err / v;
+        // (A sender read 0 at the centres' direction carries nothing at
+        // it: its reading over the spread is spread_s, and v_err / v would
+        // be 0 / 0.)
+        rel_s = 2 * s.radius / dist + layered(s, l.sbin()) + (v > 0 ? v_err / v : 0);
     else
         rel_s = 2 * s.radius / dist;
     // The part no transmittance changes (unocc and the relative terms do
@@ -2421,6 +2424,9 @@ LinkError HierarchicalSolver::link_error(const Link& l, const std::vector<double
     const double vis = std::min(tau, 1 - tau) + l.vis_err;
     const double seen = std::min(1.0, tau + l.vis_err);
     const double err = unocc * (rel_r + rel_s + vis) + seen * (spread_r + spread_s);
+    // (A NaN here is compared false against every bar: such a link was
+    // neither split nor deferred, but asked, whatever its error.)
+    FLATRAD_ASSERT(!std::isnan(err), "a cluster link's error is a number");
     const bool split_r = unocc * rel_r + seen * spread_r + (size_r >= size_s ? unocc * vis : 0) >=
                          unocc * rel_s + seen * spread_s + (size_r < size_s ? unocc * vis : 0);
     return {err, split_r};

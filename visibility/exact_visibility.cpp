@@ -53,12 +53,16 @@ double integrate(const Segment& ci, const Segment& cj, const std::vector<Segment
         by1[q] = pts[5 + 2 * q].y;
     }
 
-    // Range of slopes: the extreme patch-to-patch directions.
+    // Range of slopes: the extreme patch-to-patch directions. An end the
+    // two patches share (a room's corner) gives none; in the frame its two
+    // copies may differ by a rounding (the frame's dot products contracted
+    // differently at each call), so it is recognised by its world point.
+    const Vec2 world[4] = {ci.a, ci.b, cj.a, cj.b};
     double s_lo = std::numeric_limits<double>::infinity(), s_hi = -s_lo;
     for (size_t a = 0; a < 2; ++a)
         for (size_t c = 2; c < 4; ++c) {
             const Vec2 w = pts[c] - pts[a];
-            if (w == Vec2{}) continue;
+            if (w == Vec2{} || world[a] == world[c]) continue;
             FLATRAD_ASSERT(w.x > 0, "patch-to-patch direction outside the bisected range");
             const double s = w.y / w.x;
             s_lo = std::min(s_lo, s);

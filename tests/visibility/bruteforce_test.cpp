@@ -362,6 +362,17 @@ TEST_CASE("regressions: shafts whose corner comes from clipping") {
     }
 }
 
+TEST_CASE("regressions: a room's corner whose shared end the pair's frame rounds apart") {
+    // A ceiling element and a wall element meeting at the corner (3.2, 3.2)
+    // of a forest's room (tests/solver/hierarchical_dim_light_test.cpp), a
+    // stick between them. In the pair's frame the two copies of the corner
+    // came out 2.8e-17 apart, a patch-to-patch direction pointing backwards
+    // (FLATRAD_ASSERT in asserts builds); the shared end gives no direction.
+    const Segment ceiling{{3.2000000000000002, 3.2000000000000002}, {2.8000000000000003, 3.2000000000000002}};
+    const Segment wall{{3.2000000000000002, 2.4000000000000004}, {3.2000000000000002, 3.2000000000000002}};
+    check_against_oracle({ceiling, wall, {{{3.05, 3.0}, {3.1, 3.1}}}});  // (both ways)
+}
+
 // ---------------------------------------------------------------------------
 // 3. Degenerate blockers.
 
