@@ -24,8 +24,10 @@
 ///    where links go that deep wide leaves multiply them (1000 walls at
 ///    eps 3e-3: 30 615 links with one per leaf, 102 605 with 8).
 ///  - Links between any two nodes, created top-down: the root's self link
-///    is split into its children's pairs and self links, and so on; a link
-///    to a hierarchy leaf goes to its sides. A link (receiver r, sender s):
+///    is split into its children's pairs and self links, and so on while a
+///    cluster's members may exchange more than a share of the bar (a dark
+///    cluster keeps its self link, carrying nothing: "Refinement oracle",
+///    unresolved links); a link to a hierarchy leaf goes to its sides. A link (receiver r, sender s):
 ///      element <- element: F_rs, the exact average over r, from
 ///        MultiscaleVisibility with --vis-eps (absolute on F; clusters are
 ///        approximated only in shafts of 512 blocker pieces or more, where
@@ -235,10 +237,11 @@ struct HierarchicalOptions {
     /// same links whichever way the operator is split into parts, as the
     /// loose solves of parts apart and together stop at different points).
     bool loose_intermediate_solves = true;
-    /// Links between overlapping nodes whose sender is faint stay unsplit,
-    /// carrying nothing, while what they may leave out is within a share of
-    /// the bar (see above); off: split whenever the sender sends anything
-    /// (for tests: the oracle).
+    /// Links between overlapping nodes whose sender is faint, and a faint
+    /// cluster's self link, stay unsplit, carrying nothing, while what they
+    /// may leave out is within a share of the bar (see above); off: split
+    /// whenever the sender sends anything, self links always (for tests:
+    /// the oracle).
     bool faint_overlaps_kept = true;
     /// In scenes with at most 64 segments that may block, a link whose
     /// shaft none of them can reach (checked one by one against a capsule
