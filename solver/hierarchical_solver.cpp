@@ -729,6 +729,13 @@ private:
     TransmittanceResult link_transmittance(int r, int s, ExactWorkspace& ws, VisibilityStats& st) const;
     bool behind_closure_screen(int e, const Box& region, ExactWorkspace& ws, VisibilityStats& st) const;
     bool shown_closed_whole(Link& l, double bar, ExactWorkspace& ws, VisibilityStats& st) const;
+    // Whether self link l (not a chain's) is split only when its error asks
+    // (link_error), not always: with faint_overlaps_kept, but never a leaf
+    // cluster's (the root's in a small scene), whose split goes to its
+    // sides: no link ends at a leaf cluster, which has no table.
+    bool self_link_kept_if_faint(const Link& l) const {
+        return m_opt.faint_overlaps_kept && !m_nodes[static_cast<size_t>(l.r)].leaf_cluster;
+    }
     Box cluster_target_region(int hnode, Vec2 from) const;
     int split_element(int node);
     void pull_tables(const double* leaf_value, std::vector<double>& Bn, TableArray& I,
@@ -2580,8 +2587,7 @@ bool HierarchicalSolver::refine(const std::vector<double>& leaf_bmax, double exi
                     }
                 }
                 if (l.r == l.s && !l.uniform) {
-                    // (Without faint_overlaps_kept, split whatever it carries.)
-                    if (m_opt.faint_overlaps_kept) {
+                    if (self_link_kept_if_faint(l)) {
                         const LinkError e = link_error(l, Bn, I, false);
                         if (e.err > eps_abs) above = true;
                         if (e.err > split_at) decision[static_cast<size_t>(k)] = 3;
@@ -2671,7 +2677,7 @@ bool HierarchicalSolver::refine(const std::vector<double>& leaf_bmax, double exi
         if (first_wave && !exceeded)
             for (size_t k = 0; k < decision.size(); ++k) {
                 char& d = decision[k];
-                if (d == 1 || d == 2 || (d == 3 && (m_links[tail + k].uniform || m_opt.faint_overlaps_kept))) d = 0;
+                if (d == 1 || d == 2 || (d == 3 && (m_links[tail + k].uniform || self_link_kept_if_faint(m_links[tail + k])))) d = 0;
             }
         // 2. Split (serially: creates nodes), collecting the children links,
         // and keep the tail's survivors in place.

@@ -27,7 +27,8 @@
 ///    is split into its children's pairs and self links, and so on while a
 ///    cluster's members may exchange more than a share of the bar (a dark
 ///    cluster keeps its self link, carrying nothing: "Refinement oracle",
-///    unresolved links); a link to a hierarchy leaf goes to its sides. A link (receiver r, sender s):
+///    unresolved links); a link to a hierarchy leaf goes to its sides. A
+///    link (receiver r, sender s):
 ///      element <- element: F_rs, the exact average over r, from
 ///        MultiscaleVisibility with --vis-eps (absolute on F; clusters are
 ///        approximated only in shafts of 512 blocker pieces or more, where

@@ -263,6 +263,30 @@ TEST_CASE("hierarchical solver: review regressions (lit sides of a loop seeing i
     CHECK(h.totals.balance[0] <= 1e-12);
 }
 
+TEST_CASE("hierarchical solver: a scene whose root cluster is a hierarchy leaf, at any eps") {
+    // Two segments: the root cluster is a leaf (its children are sides). A
+    // faint cluster's self link may stay unsplit (HierarchicalOptions::
+    // faint_overlaps_kept), but a leaf cluster has no table for a link to
+    // end at: its self link is always split. At eps 1e6 and above the root's
+    // self link once stayed unsplit, and the solve read a table that is not
+    // there (a crash).
+    const Scene tiny = parse_scene(R"({"flatrad":1,"materials":{"lamp":{"reflectance":0.0,"emission":1.0},"w":{"reflectance":0.5}},
+      "surfaces":[{"name":"l","material":"lamp","side":"left","points":[[0,0],[1,0]]},
+                  {"name":"w","material":"w","side":"right","points":[[0,1],[1,1]]}]})",
+                                   "tiny.json");
+    for (double eps : {1.0, 1e6, 1e300}) {
+        CAPTURE(eps);
+        HierarchicalOptions o;
+        o.eps = eps;
+        const Solution h = solve_hierarchical(tiny, o);
+        REQUIRE(h.patches.size() == 2);
+        CHECK(h.patches[0].radiosity[0] == 1.0);  // the lamp: its emission, nothing reflected
+        CHECK(std::isfinite(h.patches[1].radiosity[0]));
+        CHECK(h.patches[1].radiosity[0] >= 0);
+        CHECK(h.patches[1].radiosity[0] <= 0.5);  // at most rho times the lamp's, even fully lit
+    }
+}
+
 TEST_CASE("hierarchical solver: data/default.json and data/tube_bank.json at the default eps, against exact") {
     // The default eps is meant to stay well inside 1% error. On default.json
     // cluster links used to carry 13-23% too little light (the pillar's own
