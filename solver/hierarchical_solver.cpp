@@ -2274,7 +2274,7 @@ LinkError HierarchicalSolver::link_error(const Link& l, const std::vector<double
         // its light: a forest's dark clusters each left their children's
         // links, carrying nothing, two per cluster down to the segments.
         // The 10^6 forest at eps 10 kept 1.14 M links instead of 3.50 M.)
-        if (!m_opt.faint_overlaps_kept) return {std::numeric_limits<double>::infinity(), true};
+        if (!self_link_kept_if_faint(l)) return {std::numeric_limits<double>::infinity(), true};
         const double lost = m_Bmax[static_cast<size_t>(l.s)] * m_Lsum[static_cast<size_t>(l.s)];
         if (!(lost > 0)) return {};
         return {lost / unresolved_share, true};
