@@ -31,7 +31,7 @@ std::vector<Vec2> convex_hull(std::vector<Vec2> p) {
 
 }  // namespace
 
-std::vector<char> segments_on_hull(const std::vector<Segment>& segments, double extent) {
+std::vector<char> segments_on_hull(const std::vector<Segment>& segments) {
     std::vector<char> on(segments.size(), 0);
     if (segments.size() <= 2) {  // two segments: nothing else to block them
         on.assign(segments.size(), 1);
@@ -46,10 +46,10 @@ std::vector<char> segments_on_hull(const std::vector<Segment>& segments, double 
     const std::vector<Vec2> hull = convex_hull(pts);
     if (hull.size() < 3) return on;  // all collinear: collinear segments face nothing anyway, but say "unsure"
     // A segment is on the boundary when its line supports the hull: for its
-    // unit normal n (either sign), max over the hull of n . v equals n . a.
-    // The maximising vertex is found by binary search on the hull's outward
-    // edge normals, whose angles increase around a counter-clockwise hull
-    // (O(log H) per segment, O(N log N) in all).
+    // unit normal n (either sign), no hull vertex lies beyond the line on
+    // n's side. The vertex furthest along n is found by binary search on the
+    // hull's outward edge normals, whose angles increase around a
+    // counter-clockwise hull (O(log H) per segment, O(N log N) in all).
     const size_t H = hull.size();
     std::vector<double> angle(H);
     for (size_t i = 0; i < H; ++i) {
@@ -58,31 +58,59 @@ std::vector<char> segments_on_hull(const std::vector<Segment>& segments, double 
         if (i > 0)
             while (angle[i] < angle[i - 1]) angle[i] += 2 * std::numbers::pi;
     }
-    auto support = [&](Vec2 n) {
+    auto furthest = [&](Vec2 n) {
         double t = std::atan2(n.y, n.x);
         while (t < angle[0]) t += 2 * std::numbers::pi;
         while (t >= angle[0] + 2 * std::numbers::pi) t -= 2 * std::numbers::pi;
         // Vertex j = first edge whose normal angle >= t: edges j-1 and j bracket n.
-        const size_t j = static_cast<size_t>(std::lower_bound(angle.begin(), angle.end(), t) - angle.begin()) % H;
-        double best = dot(n, hull[j]);
+        size_t best = static_cast<size_t>(std::lower_bound(angle.begin(), angle.end(), t) - angle.begin()) % H;
         // Neighbours too: the angles are rounded.
-        best = std::max({best, dot(n, hull[(j + 1) % H]), dot(n, hull[(j + H - 1) % H])});
+        for (size_t k : {(best + 1) % H, (best + H - 1) % H})
+            if (dot(n, hull[k]) > dot(n, hull[best])) best = k;
         return best;
     };
-    const double tol = 1e-12 * extent;
     for (size_t k = 0; k < segments.size(); ++k) {
         const Segment& s = segments[k];
-        const double L = s.length();
+        const Vec2 d = s.b - s.a;
+        const double L = norm(d);
         if (!(L > 0)) continue;
-        const Vec2 n = rot90(s.b - s.a) / L;
-        const double h = dot(n, s.a);
-        on[k] = support(n) <= h + tol || support(-n) <= -h + tol;
+        // Offset of v beyond the line on n's side, measured from the nearer
+        // end (a far end would add its own rounding), against what rounding
+        // coordinates read from text (1e-12 relative) moves v or the line
+        // there: the line near v's foot t is (1 - t) a + t b, known to
+        // 1e-12 (|1 - t| |a| + |t| |b|). Local, not the scene's extent: a
+        // wall 1e12 long beside a pillar of size 1 must still see the pillar
+        // stick out by 0.8 (a fuzzed scene whose far wall was taken for a
+        // hull wall, so that nothing blocked through it).
+        auto beyond = [&](Vec2 n, Vec2 v) {
+            const double t = dot(v - s.a, d) / (L * L);
+            const double offset = dot(n, v - (t < 0.5 ? s.a : s.b));
+            const double scale = std::max(norm(v), std::abs(1 - t) * norm(s.a) + std::abs(t) * norm(s.b));
+            return offset > 1e-12 * scale;
+        };
+        // The vertices on n's side of the line form one arc of the hull
+        // around the furthest one (convexity). Walk it both ways while the
+        // offset is positive: a vertex within rounding of the line must not
+        // hide a nearer one that sticks out by more than its own rounding.
+        auto side_clear = [&](Vec2 n) {
+            const size_t j = furthest(n);
+            if (beyond(n, hull[j])) return false;
+            for (const size_t step : {size_t{1}, H - 1})
+                for (size_t m = (j + step) % H; m != j; m = (m + step) % H) {
+                    const Vec2 v = hull[m];
+                    if (dot(n, v - s.a) <= 0 && dot(n, v - s.b) <= 0) break;
+                    if (beyond(n, v)) return false;
+                }
+            return true;
+        };
+        const Vec2 n = rot90(d) / L;
+        on[k] = side_clear(n) || side_clear(-n);
     }
     return on;
 }
 
 std::vector<char> possible_blockers(const Scene& scene) {
-    std::vector<char> on = segments_on_hull(scene.segment_geometry(), scene.extent());
+    std::vector<char> on = segments_on_hull(scene.segment_geometry());
     for (char& c : on) c = !c;
     return on;
 }

@@ -16,11 +16,13 @@
 namespace flatrad {
 
 /// Per segment: 1 when it lies on the boundary of the convex hull of all of
-/// `segments` (within 1e-12 x `extent`, for coordinates read from text).
-/// Conservative: 0 when unsure (zero length, all points collinear). O(N log
-/// N): the hull, then a binary search of each segment's supporting
-/// direction among the hull's edges.
-std::vector<char> segments_on_hull(const std::vector<Segment>& segments, double extent);
+/// `segments`, up to the rounding of coordinates read from text (1e-12 of
+/// the coordinates' size where the hull meets the segment's line; local,
+/// so that one huge wall does not blur the rest of the scene). Conservative:
+/// 0 when unsure (zero length, all points collinear). O(N log N): the hull,
+/// then a binary search of each segment's supporting direction among the
+/// hull's edges.
+std::vector<char> segments_on_hull(const std::vector<Segment>& segments);
 
 /// Per segment of `scene`: 1 when it may block light between two others
 /// (not on the hull's boundary).

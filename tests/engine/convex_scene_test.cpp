@@ -137,3 +137,40 @@ TEST_CASE("possible blockers: a circle's walls block nothing, a lamp inside it d
     CHECK(count == 1);
     CHECK(b.back() == 1);  // the lamp, read last
 }
+
+TEST_CASE("possible blockers: a wall 1e12 long is no hull wall when a pillar beside it sticks out past its line") {
+    // Reduced from a fuzzed scene (fuzz/corpus/regress_far_wall_hull_tolerance.json):
+    // the tolerance was 1e-12 of the scene's extent, here 1 unit, so the
+    // pillar's 0.8 past the long wall went unseen; the wall blocked nothing
+    // and the exact solver's rows summed to 2.6 (negative radiosity).
+    const auto scene = [](double far) {
+        return parse_scene(fmt::format(R"({{"flatrad": 1, "materials": {{"m": {{"reflectance": 0.5}}}},
+            "surfaces": [{{"name": "room", "material": "m", "closed": true, "side": "in", "points": [[1,3],[3,0],[0,{}]]}},
+                         {{"name": "pillar", "material": "m", "side": "out", "circle": {{"center": [2.5,0.4], "radius": 1.3, "segments": 44}}}}]}})",
+                                       far),
+                           "far");
+    };
+    for (double far : {10.0, 1e6, 1e12, 1e15}) {
+        CAPTURE(far);
+        const Scene s = scene(far);
+        const std::vector<char> b = possible_blockers(s);
+        for (size_t k = 0; k < s.segments.size(); ++k) {
+            CAPTURE(k);
+            CHECK(b[k] == (on_hull_oracle(s, s.segments[k]) ? 0 : 1));
+        }
+        // The long wall from (3, 0) crosses the pillar at any length: it blocks.
+        CHECK(b[1] == 1);
+    }
+}
+
+TEST_CASE("possible blockers: a slanted wall split at rounded points stays a hull wall, far from the origin too") {
+    // Thirds are not doubles: the middle corner of the split wall is off the
+    // line of its neighbour by a rounding of its coordinates' size, which the
+    // text tolerance (1e-12 relative) must absorb at any offset.
+    for (double x0 : {0.0, 1e3, 1e6, 1e9}) {
+        CAPTURE(x0);
+        const Scene s = parse_scene(
+            polygon_scene({{x0, 0}, {x0 + 1, 1.0 / 3}, {x0 + 2, 2.0 / 3}, {x0 + 3, 1}, {x0 + 3, 5}, {x0, 5}}), "slant");
+        CHECK(no_segment_can_block(s));
+    }
+}

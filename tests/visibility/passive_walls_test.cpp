@@ -35,7 +35,7 @@ TEST_CASE("passive walls: same exact and multi-scale F as the full hierarchy, fe
     double worst = 0;
     for (int room_no = 0; room_no < 12; ++room_no) {
         const test::RandomRoom room = test::make_random_room(rng, 4 + room_no % 3, 3 + room_no % 5);
-        const std::vector<char> on = segments_on_hull(room.segments, 1.0);
+        const std::vector<char> on = segments_on_hull(room.segments);
         std::vector<char> can(on.size());
         for (size_t k = 0; k < on.size(); ++k) can[k] = !on[k];
         const long walls = static_cast<long>(std::count(on.begin(), on.end(), 1));
