@@ -643,17 +643,24 @@ public:
         m_side_room = std::move(facts.side_room);
         convex_object_skips(facts.conn);
         const bool sinks = std::find(m_visible_sink.begin(), m_visible_sink.end(), 1) != m_visible_sink.end();
-        // Row sums of 1 hold for escape-free patches when no sink can be seen.
-        m_closed_patch.assign(scene.patches.size(), 0);
-        if (!sinks)
-            for (size_t p = 0; p < scene.patches.size(); ++p) m_closed_patch[p] = m_escape_free[p];
-        m_convex_room = o.convex_room_shortcut && m_unblockable && !sinks &&
-                        std::find(m_escape_free.begin(), m_escape_free.end(), 0) == m_escape_free.end();
-        for (size_t p = 0; p < scene.patches.size() && m_convex_room; ++p) {
+        // A lit patch that neither reflects nor emits, in any channel, sends
+        // nothing, so no link has it as its sender (gather_from_children's
+        // can_send): a row that sees it misses what it absorbs, as with a
+        // sink. (Closing such rows to 1 gave that light back to the walls:
+        // a black plate in a white room was not there at all.)
+        bool inert = false;
+        for (size_t p = 0; p < scene.patches.size() && !inert; ++p) {
             const Material& m = material(static_cast<int>(p));
-            m_convex_room = *std::max_element(m.reflectance.begin(), m.reflectance.end()) > 0 ||
-                            *std::max_element(m.emission.begin(), m.emission.end()) > 0;
+            inert = !(*std::max_element(m.reflectance.begin(), m.reflectance.end()) > 0 ||
+                      *std::max_element(m.emission.begin(), m.emission.end()) > 0);
         }
+        // Row sums of 1 hold for escape-free patches when no sink and no
+        // inert patch can be seen.
+        m_closed_patch.assign(scene.patches.size(), 0);
+        if (!sinks && !inert)
+            for (size_t p = 0; p < scene.patches.size(); ++p) m_closed_patch[p] = m_escape_free[p];
+        m_convex_room = o.convex_room_shortcut && m_unblockable && !sinks && !inert &&
+                        std::find(m_escape_free.begin(), m_escape_free.end(), 0) == m_escape_free.end();
     }
 
     Solution run();
