@@ -20,6 +20,12 @@ std::string channels(const std::vector<double>& v) {
     return s + ")";
 }
 
+// A residual this far above the solvers' own targets (1e-12 for the
+// hierarchical GMRES, a few ulps for the exact LU; the reported residual is
+// a max norm against the 2-norm GMRES stops at, which may differ by a few
+// times) means the linear solve stopped short: said, not only shown.
+constexpr double residual_warning = 1e-9;
+
 double mean(const std::vector<double>& v) {
     return v.empty() ? 0.0 : std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
 }
@@ -41,6 +47,10 @@ void print_summary(std::ostream& os, const Scene& scene, const Solution& solutio
     os << fmt::format("  energy: emitted {}, absorbed {}, escaped {}, balance {}; residual {:.3g}\n",
                       channels(t.emitted), channels(t.absorbed), channels(t.escaped),
                       channels(t.balance), s.residual);
+    if (s.residual > residual_warning)
+        os << fmt::format("  warning: the linear solve stopped at residual {:.3g}, short of its target; reflectance "
+                          "near 1 makes the system stiff, and B may be off by about the residual over (1 - rho)\n",
+                          s.residual);
 
     std::vector<std::size_t> order(std::min(scene.patches.size(), solution.patches.size()));
     std::iota(order.begin(), order.end(), std::size_t{0});
