@@ -654,8 +654,9 @@ public:
             inert = !(*std::max_element(m.reflectance.begin(), m.reflectance.end()) > 0 ||
                       *std::max_element(m.emission.begin(), m.emission.end()) > 0);
         }
-        // Row sums of 1 hold for escape-free patches when no sink and no
-        // inert patch can be seen.
+        // Row sums of 1 hold for escape-free patches when no sink can be
+        // seen and the scene holds no inert patch (seen or not: the check
+        // stays simple, and only the closure's accuracy is lost).
         m_closed_patch.assign(scene.patches.size(), 0);
         if (!sinks && !inert)
             for (size_t p = 0; p < scene.patches.size(); ++p) m_closed_patch[p] = m_escape_free[p];
