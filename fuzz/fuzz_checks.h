@@ -24,6 +24,7 @@
 #include "engine/scene.h"
 #include "solver/exact_solver.h"
 #include "solver/group_form_factor.h"
+#include "solver/hierarchical_solver.h"
 
 namespace flatrad::fuzz {
 
@@ -111,6 +112,42 @@ inline Finding check_solution(const Scene& scene, int K) {
     return std::nullopt;
 }
 
+/// The hierarchical solver at eps `eps` on one thread: no assert, no
+/// sanitizer report, and every radiosity, total and stat a finite number.
+/// Not B >= 0: in stiff scenes (reflectance near 1) the refinement's error,
+/// which eps bounds in power, comes back about 1 / (1 - rho) times and may
+/// push a dim patch below 0 (docs/solver-history.md, forty-first session).
+inline Finding check_hierarchical(const Scene& scene, double eps) {
+    Solution sol;
+    try {
+        HierarchicalOptions o;
+        o.eps = eps;
+        o.threads = 1;
+        sol = solve_hierarchical(scene, o);
+    } catch (const InputError&) {
+        return std::nullopt;  // a closed white enclosure: a clean refusal
+    }
+    if (sol.patches.size() != scene.patches.size()) return broken("hierarchical: patch count of the solution", 0);
+    for (const PatchResult& p : sol.patches) {
+        for (double b : p.radiosity)
+            if (!std::isfinite(b)) return broken("hierarchical: patch radiosity not finite", b);
+        for (const ElementValue& e : p.elements)
+            for (double b : e.B)
+                if (!std::isfinite(b)) return broken("hierarchical: element radiosity not finite", b);
+    }
+    for (const auto* v : {&sol.totals.emitted, &sol.totals.absorbed, &sol.totals.escaped, &sol.totals.balance})
+        for (double x : *v)
+            if (!std::isfinite(x)) return broken("hierarchical: totals not finite", x);
+    if (!std::isfinite(sol.stats.residual)) return broken("hierarchical: residual not finite", sol.stats.residual);
+    return std::nullopt;
+}
+
+// The hierarchical target's eps: the default's neighbourhood is slow on
+// stiff fuzzed scenes (one took 3.6 s at eps 1e-2 in a Release build, past
+// libFuzzer's 10 s in the sanitizers'); these two still split links down
+// to elements and exercise clusters, visibility and the solve.
+inline constexpr double hierarchical_eps[] = {1.0, 0.1};
+
 /// Everything above on one input text. nullopt: refused cleanly or all
 /// invariants hold.
 inline Finding check_input(const std::string& text) {
@@ -126,6 +163,23 @@ inline Finding check_input(const std::string& text) {
     for (int K : {1, 2})
         if (scene.patches.size() * static_cast<size_t>(K) <= max_elements)
             if (Finding f = check_solution(scene, K)) return f;
+    return std::nullopt;
+}
+
+/// The hierarchical solver's checks on one input text (the second target,
+/// fuzz/fuzz_hierarchical.cpp): parsed as above, and a scene of at most
+/// max_segments segments solved at each of hierarchical_eps.
+inline Finding check_hierarchical_input(const std::string& text) {
+    Scene scene;
+    try {
+        scene = parse_scene(text, "fuzz.json");
+    } catch (const InputError&) {
+        return std::nullopt;
+    }
+    if (Finding f = check_scene(scene)) return f;
+    if (scene.segments.size() > max_segments) return std::nullopt;
+    for (double eps : hierarchical_eps)
+        if (Finding f = check_hierarchical(scene, eps)) return f;
     return std::nullopt;
 }
 
