@@ -46,5 +46,33 @@ inline bool meets(const Segment& s, const std::vector<Vec2>& poly) {
     return false;
 }
 
+// Whether segment s passes from one side of the polygon to the other: it
+// properly crosses an edge (each strictly on both sides of the other's
+// line, beyond locate's rounding margin for s's ends), or a corner of the
+// polygon lies on s (within that margin, its ends included: a corner is
+// where s could slip out). A segment that only touches an edge with an end
+// (a shelf against a wall) does not.
+inline bool crosses(const Segment& s, const std::vector<Vec2>& poly) {
+    const size_t n = poly.size();
+    const auto margin = [](Vec2 a, Vec2 b, Vec2 p) {
+        return 8 * std::numeric_limits<double>::epsilon() * (std::abs(b.x - a.x) + std::abs(b.y - a.y)) *
+               (std::abs(p.x - a.x) + std::abs(p.y - a.y) + 1e-300);
+    };
+    const double lo_x = std::min(s.a.x, s.b.x), hi_x = std::max(s.a.x, s.b.x);
+    const double lo_y = std::min(s.a.y, s.b.y), hi_y = std::max(s.a.y, s.b.y);
+    for (size_t k = 0; k < n; ++k) {
+        const Vec2 a = poly[k], b = poly[(k + 1) % n];
+        // The corner a on s.
+        if (std::abs(orient(s.a, s.b, a)) <= margin(s.a, s.b, a) && lo_x <= a.x && a.x <= hi_x && lo_y <= a.y &&
+            a.y <= hi_y)
+            return true;
+        const double o1 = orient(a, b, s.a), o2 = orient(a, b, s.b);
+        const double o3 = orient(s.a, s.b, a), o4 = orient(s.a, s.b, b);
+        const bool ends_apart = (o1 > margin(a, b, s.a) && o2 < -margin(a, b, s.b)) ||
+                                (o1 < -margin(a, b, s.a) && o2 > margin(a, b, s.b));
+        if (ends_apart && ((o3 > 0 && o4 < 0) || (o3 < 0 && o4 > 0))) return true;
+    }
+    return false;
+}
 
 }  // namespace flatrad

@@ -30,8 +30,18 @@ std::vector<char> visible_sinks(const Scene& scene, const Connectivity& conn) {
             const Segment& g = scene.segments[s].seg;
             const Where wa = locate(g.a, L.polygon), wb = locate(g.b, L.polygon);
             const bool touches = wa == Where::Unsure || wb == Where::Unsure || meets(g, L.polygon);
-            if (touches || wa != Where::Inside || wb != Where::Inside) all_inside = false;
-            if (touches || wa != Where::Outside || wb != Where::Outside) none_inside = false;
+            bool in = !touches && wa == Where::Inside && wb == Where::Inside;
+            bool out = !touches && wa == Where::Outside && wb == Where::Outside;
+            // Touching with no end on the far side (a shelf or a lamp
+            // against a wall): it stays on its side of L when it crosses no
+            // edge and meets no corner (polygon_tests.h), its midpoint
+            // telling which side (both ends on L: a chord, inside or out).
+            // L stays closed where it is touched, so such a segment sees
+            // nothing beyond L, and nothing beyond L sees it.
+            const bool no_end_out = wa != Where::Outside && wb != Where::Outside;
+            if (touches && no_end_out && !crosses(g, L.polygon)) in = locate(0.5 * (g.a + g.b), L.polygon) == Where::Inside;
+            if (!in) all_inside = false;
+            if (!out) none_inside = false;
         }
         // L's own lit sides see its unlit ones on the same side of it: a
         // lit interior side sees the interior sinks, a lit exterior side (of

@@ -11,8 +11,10 @@
 /// Rule (sufficient): the segment is on a simple loop L of known orientation
 /// (engine/connectivity.h) and
 ///  - the unlit side faces L's exterior, every segment not on L lies
-///    strictly inside L (both endpoints inside, no contact with L), and no
-///    side of L facing its exterior is lit; or
+///    inside L (both endpoints inside and no contact with L; or, touching
+///    L, no endpoint outside, no edge properly crossed, no corner of L on
+///    it and its midpoint inside: a shelf against a wall, as L stays closed
+///    where it is touched), and no side of L facing its exterior is lit; or
 ///  - the unlit side faces L's interior, no segment not on L has an
 ///    endpoint inside L or touches L, and no side of L facing its interior
 ///    is lit.
