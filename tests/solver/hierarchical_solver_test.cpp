@@ -263,6 +263,23 @@ TEST_CASE("hierarchical solver: review regressions (lit sides of a loop seeing i
     CHECK(h.totals.balance[0] <= 1e-12);
 }
 
+namespace {
+
+// A one-channel scene whose lamp has B = 1: the hierarchical solution at
+// the default eps within patch_tol of the exact one at K elements per patch
+// (absolute, i.e. relative to the lamp), and its balance within the bar.
+void check_default_eps_against_exact(const Scene& s, int K, double patch_tol, double balance_bar) {
+    const Solution h = solve_hierarchical(s);
+    const Solution e = solve_exact(s, {K, 0});
+    for (size_t p = 0; p < s.patches.size(); ++p) {
+        CAPTURE(p);
+        CHECK(std::abs(h.patches[p].radiosity[0] - e.patches[p].radiosity[0]) <= patch_tol);
+    }
+    CHECK(h.totals.balance[0] <= balance_bar);
+}
+
+}  // namespace
+
 TEST_CASE("hierarchical solver: a black plate in a closed room absorbs what reaches it") {
     // Reflectance 0 and no emission on both sides: no link has the plate as
     // its sender, so the walls' rows over their links miss what it absorbs.
@@ -274,17 +291,11 @@ TEST_CASE("hierarchical solver: a black plate in a closed room absorbs what reac
                   {"name":"lamp","material":"l","side":"both","points":[[1.5,2],[2.5,2]]},
                   {"name":"plate","material":"b","side":"both","points":[[0.5,0.5],[1.5,0.5]]}]})",
                                 "black_plate.json");
-    const Solution h = solve_hierarchical(s);
-    const Solution e = solve_exact(s, {8, 0});
     // The default eps's ~1% (README) with a 3x margin, as above; the walls'
     // reflectance 0.9 multiplies a row's error by up to 10 in B and in the
     // balance, measured 4e-3 of the lamp's B and 7e-3.
     constexpr double patch_tol = 3e-2, balance_bar = 2e-2;
-    for (size_t p = 0; p < s.patches.size(); ++p) {
-        CAPTURE(p);
-        CHECK(std::abs(h.patches[p].radiosity[0] - e.patches[p].radiosity[0]) <= patch_tol * 1.0);  // the lamp's B is 1
-    }
-    CHECK(h.totals.balance[0] <= balance_bar);
+    check_default_eps_against_exact(s, 8, patch_tol, balance_bar);
 }
 
 TEST_CASE("hierarchical solver: a lamp against the wall of a stiff room keeps the rows closed") {
@@ -297,17 +308,11 @@ TEST_CASE("hierarchical solver: a lamp against the wall of a stiff room keeps th
       "surfaces":[{"name":"room","material":"w","closed":true,"side":"in","points":[[0,0],[4,0],[4,3],[0,3]]},
                   {"name":"lamp","material":"l","side":"both","points":[[3.5,1],[4,1]]}]})",
                                 "lamp_on_wall.json");
-    const Solution h = solve_hierarchical(s);
-    const Solution e = solve_exact(s, {16, 0});
     // About the default eps's accuracy on the data scenes (README: 0.06-0.2%
     // relative L2) with margin, against the lamp's B of 1; measured 4e-4
     // and 8e-5 (the old code: 5.7e-2 and 5.4e-2).
     constexpr double patch_tol = 1e-2, balance_bar = 1e-2;
-    for (size_t p = 0; p < s.patches.size(); ++p) {
-        CAPTURE(p);
-        CHECK(std::abs(h.patches[p].radiosity[0] - e.patches[p].radiosity[0]) <= patch_tol * 1.0);
-    }
-    CHECK(h.totals.balance[0] <= balance_bar);
+    check_default_eps_against_exact(s, 16, patch_tol, balance_bar);
 }
 
 TEST_CASE("hierarchical solver: a scene whose root cluster is a hierarchy leaf, at any eps") {
