@@ -148,9 +148,11 @@ inline Finding check_hierarchical(const Scene& scene, double eps) {
 // to elements and exercise clusters, visibility and the solve.
 inline constexpr double hierarchical_eps[] = {1.0, 0.1};
 
-/// Everything above on one input text. nullopt: refused cleanly or all
-/// invariants hold.
-inline Finding check_input(const std::string& text) {
+/// Parses `text` and, for an accepted scene that keeps its invariants and
+/// has at most max_segments segments, returns check(scene). nullopt:
+/// refused cleanly, too large to solve, or the check found nothing.
+template <class Check>
+Finding on_accepted_scene(const std::string& text, const Check& check) {
     Scene scene;
     try {
         scene = parse_scene(text, "fuzz.json");
@@ -159,28 +161,30 @@ inline Finding check_input(const std::string& text) {
     }
     if (Finding f = check_scene(scene)) return f;
     if (scene.segments.size() > max_segments) return std::nullopt;
-    if (Finding f = check_form_factors(scene)) return f;
-    for (int K : {1, 2})
-        if (scene.patches.size() * static_cast<size_t>(K) <= max_elements)
-            if (Finding f = check_solution(scene, K)) return f;
-    return std::nullopt;
+    return check(scene);
+}
+
+/// Everything above on one input text. nullopt: refused cleanly or all
+/// invariants hold.
+inline Finding check_input(const std::string& text) {
+    return on_accepted_scene(text, [](const Scene& scene) -> Finding {
+        if (Finding f = check_form_factors(scene)) return f;
+        for (int K : {1, 2})
+            if (scene.patches.size() * static_cast<size_t>(K) <= max_elements)
+                if (Finding f = check_solution(scene, K)) return f;
+        return std::nullopt;
+    });
 }
 
 /// The hierarchical solver's checks on one input text (the second target,
-/// fuzz/fuzz_hierarchical.cpp): parsed as above, and a scene of at most
-/// max_segments segments solved at each of hierarchical_eps.
+/// fuzz_hierarchical): an accepted scene of at most max_segments segments
+/// solved at each of hierarchical_eps.
 inline Finding check_hierarchical_input(const std::string& text) {
-    Scene scene;
-    try {
-        scene = parse_scene(text, "fuzz.json");
-    } catch (const InputError&) {
+    return on_accepted_scene(text, [](const Scene& scene) -> Finding {
+        for (double eps : hierarchical_eps)
+            if (Finding f = check_hierarchical(scene, eps)) return f;
         return std::nullopt;
-    }
-    if (Finding f = check_scene(scene)) return f;
-    if (scene.segments.size() > max_segments) return std::nullopt;
-    for (double eps : hierarchical_eps)
-        if (Finding f = check_hierarchical(scene, eps)) return f;
-    return std::nullopt;
+    });
 }
 
 }  // namespace flatrad::fuzz

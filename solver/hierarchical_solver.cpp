@@ -649,11 +649,7 @@ public:
         // sink. (Closing such rows to 1 gave that light back to the walls:
         // a black plate in a white room was not there at all.)
         bool inert = false;
-        for (size_t p = 0; p < scene.patches.size() && !inert; ++p) {
-            const Material& m = material(static_cast<int>(p));
-            inert = !(*std::max_element(m.reflectance.begin(), m.reflectance.end()) > 0 ||
-                      *std::max_element(m.emission.begin(), m.emission.end()) > 0);
-        }
+        for (size_t p = 0; p < scene.patches.size() && !inert; ++p) inert = !sends(material(static_cast<int>(p)));
         // Row sums of 1 hold for escape-free patches when no sink can be
         // seen and the scene holds no inert patch (seen or not: the check
         // stays simple, and only the closure's accuracy is lost).
@@ -667,6 +663,13 @@ public:
     Solution run();
 
 private:
+    // Whether a patch of material m sends anything: it reflects or emits in
+    // some channel (an element's can_send; a patch that does not is no
+    // link's sender).
+    static bool sends(const Material& m) {
+        return *std::max_element(m.reflectance.begin(), m.reflectance.end()) > 0 ||
+               *std::max_element(m.emission.begin(), m.emission.end()) > 0;
+    }
     const Material& material(int patch) const {
         return m_scene.materials[static_cast<size_t>(m_scene.patches[static_cast<size_t>(patch)].material)];
     }
@@ -1170,10 +1173,8 @@ void HierarchicalSolver::build_tree() {
 void HierarchicalSolver::gather_from_children(size_t k) {
     Node& n = m_nodes[k];
     if (n.kind == Kind::Element) {
-        bool any = false;
-        for (int c = 0; c < m_C; ++c) any = any || rho(static_cast<int>(k), c) > 0 || emission(static_cast<int>(k), c) > 0;
-        n.can_send = any;
-        n.send_rooms = any ? n.recv_rooms : 0;
+        n.can_send = sends(material(n.patch));
+        n.send_rooms = n.can_send ? n.recv_rooms : 0;
     }
     double* dst = n.table >= 0 ? &m_sensitivity[static_cast<size_t>(n.table) * TW] : nullptr;
     for (int ch = n.child + n.nchild; ch-- > n.child;) {

@@ -11,17 +11,22 @@ namespace flatrad {
 
 enum class Where { Inside, Outside, Unsure };
 
+// The rounding margin of orient(a, b, p): a few ulps of its two factors.
+inline double orient_margin(Vec2 a, Vec2 b, Vec2 p) {
+    return 8 * std::numeric_limits<double>::epsilon() * (std::abs(b.x - a.x) + std::abs(b.y - a.y)) *
+           (std::abs(p.x - a.x) + std::abs(p.y - a.y) + 1e-300);
+}
+
 // Crossing number of p against the polygon, with a rounding margin: a point
-// whose orientation against some edge it projects onto is within `tol` of
-// zero is Unsure.
+// whose orientation against some edge it projects onto is within
+// orient_margin of zero is Unsure.
 inline Where locate(Vec2 p, const std::vector<Vec2>& poly) {
     bool inside = false;
     const size_t n = poly.size();
     for (size_t k = 0; k < n; ++k) {
         const Vec2 a = poly[k], b = poly[(k + 1) % n];
         const double o = orient(a, b, p);
-        const double tol = 8 * std::numeric_limits<double>::epsilon() * (std::abs(b.x - a.x) + std::abs(b.y - a.y)) *
-                           (std::abs(p.x - a.x) + std::abs(p.y - a.y) + 1e-300);
+        const double tol = orient_margin(a, b, p);
         const bool within_x = std::min(a.x, b.x) <= p.x && p.x <= std::max(a.x, b.x);
         const bool within_y = std::min(a.y, b.y) <= p.y && p.y <= std::max(a.y, b.y);
         if (std::abs(o) <= tol && within_x && within_y) return Where::Unsure;  // on (or at) the edge
@@ -54,22 +59,17 @@ inline bool meets(const Segment& s, const std::vector<Vec2>& poly) {
 // (a shelf against a wall) does not.
 inline bool crosses(const Segment& s, const std::vector<Vec2>& poly) {
     const size_t n = poly.size();
-    const auto margin = [](Vec2 a, Vec2 b, Vec2 p) {
-        return 8 * std::numeric_limits<double>::epsilon() * (std::abs(b.x - a.x) + std::abs(b.y - a.y)) *
-               (std::abs(p.x - a.x) + std::abs(p.y - a.y) + 1e-300);
-    };
     const double lo_x = std::min(s.a.x, s.b.x), hi_x = std::max(s.a.x, s.b.x);
     const double lo_y = std::min(s.a.y, s.b.y), hi_y = std::max(s.a.y, s.b.y);
     for (size_t k = 0; k < n; ++k) {
         const Vec2 a = poly[k], b = poly[(k + 1) % n];
+        const double o3 = orient(s.a, s.b, a), o4 = orient(s.a, s.b, b);
         // The corner a on s.
-        if (std::abs(orient(s.a, s.b, a)) <= margin(s.a, s.b, a) && lo_x <= a.x && a.x <= hi_x && lo_y <= a.y &&
-            a.y <= hi_y)
+        if (std::abs(o3) <= orient_margin(s.a, s.b, a) && lo_x <= a.x && a.x <= hi_x && lo_y <= a.y && a.y <= hi_y)
             return true;
         const double o1 = orient(a, b, s.a), o2 = orient(a, b, s.b);
-        const double o3 = orient(s.a, s.b, a), o4 = orient(s.a, s.b, b);
-        const bool ends_apart = (o1 > margin(a, b, s.a) && o2 < -margin(a, b, s.b)) ||
-                                (o1 < -margin(a, b, s.a) && o2 > margin(a, b, s.b));
+        const bool ends_apart = (o1 > orient_margin(a, b, s.a) && o2 < -orient_margin(a, b, s.b)) ||
+                                (o1 < -orient_margin(a, b, s.a) && o2 > orient_margin(a, b, s.b));
         if (ends_apart && ((o3 > 0 && o4 < 0) || (o3 < 0 && o4 > 0))) return true;
     }
     return false;
