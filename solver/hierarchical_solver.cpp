@@ -35,6 +35,7 @@
 #include "solver/rooms.h"
 #include "solver/front_envelopes.h"
 #include "solver/self_occlusion.h"
+#include "solver/closed_rows.h"
 #include "solver/sink_visibility.h"
 #include "solver/table_array.h"
 #include "solver/uninitialized_allocator.h"
@@ -525,10 +526,20 @@ struct LinkError {
 // What the scene's connectivity says (engine/connectivity.h, solver/rooms.h,
 // solver/sink_visibility.h): computed beside the hierarchy (see
 // HierarchicalSolver's members).
+// Whether a patch of material m sends anything: it reflects or emits in
+// some channel (an element's can_send; a patch that does not, inert, is no
+// link's sender).
+bool sends(const Material& m) {
+    return *std::max_element(m.reflectance.begin(), m.reflectance.end()) > 0 ||
+           *std::max_element(m.emission.begin(), m.emission.end()) > 0;
+}
+
 struct SceneFacts {
     Connectivity conn;
     std::vector<char> escape_free;   // per patch
     std::vector<char> visible_sink;  // per segment side
+    std::vector<char> inert;         // per patch: !sends
+    std::vector<char> closed_row;    // per patch (solver/closed_rows.h)
     std::vector<int> side_room;      // per segment side
 };
 
@@ -537,6 +548,10 @@ SceneFacts scene_facts(const Scene& scene) {
     f.conn = scene_connectivity(scene);
     f.escape_free = escape_free_patches(scene, f.conn);
     f.visible_sink = visible_sinks(scene, f.conn);
+    f.inert.resize(scene.patches.size());
+    for (size_t p = 0; p < scene.patches.size(); ++p)
+        f.inert[p] = sends(scene.materials[static_cast<size_t>(scene.patches[p].material)]) ? 0 : 1;
+    f.closed_row = closed_rows(scene, f.conn, f.escape_free, f.visible_sink, f.inert);
     f.side_room = side_rooms(scene, f.conn);
     return f;
 }
@@ -647,15 +662,11 @@ public:
         // nothing, so no link has it as its sender (gather_from_children's
         // can_send): a row that sees it misses what it absorbs, as with a
         // sink. (Closing such rows to 1 gave that light back to the walls:
-        // a black plate in a white room was not there at all.)
-        bool inert = false;
-        for (size_t p = 0; p < scene.patches.size() && !inert; ++p) inert = !sends(material(static_cast<int>(p)));
-        // Row sums of 1 hold for escape-free patches when no sink can be
-        // seen and the scene holds no inert patch (seen or not: the check
-        // stays simple, and only the closure's accuracy is lost).
-        m_closed_patch.assign(scene.patches.size(), 0);
-        if (!sinks && !inert)
-            for (size_t p = 0; p < scene.patches.size(); ++p) m_closed_patch[p] = m_escape_free[p];
+        // a black plate in a white room was not there at all.) Rows close
+        // only where a closed loop keeps such patches and the visible sinks
+        // out of sight (solver/closed_rows.h).
+        const bool inert = std::find(facts.inert.begin(), facts.inert.end(), 1) != facts.inert.end();
+        m_closed_patch = std::move(facts.closed_row);
         m_convex_room = o.convex_room_shortcut && m_unblockable && !sinks && !inert &&
                         std::find(m_escape_free.begin(), m_escape_free.end(), 0) == m_escape_free.end();
     }
@@ -663,13 +674,6 @@ public:
     Solution run();
 
 private:
-    // Whether a patch of material m sends anything: it reflects or emits in
-    // some channel (an element's can_send; a patch that does not is no
-    // link's sender).
-    static bool sends(const Material& m) {
-        return *std::max_element(m.reflectance.begin(), m.reflectance.end()) > 0 ||
-               *std::max_element(m.emission.begin(), m.emission.end()) > 0;
-    }
     const Material& material(int patch) const {
         return m_scene.materials[static_cast<size_t>(m_scene.patches[static_cast<size_t>(patch)].material)];
     }

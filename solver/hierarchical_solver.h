@@ -167,8 +167,9 @@
 ///    stats.iterations the longest run's operator applications. The
 ///    residual is then checked on the whole operator.
 ///  - Row sums: a leaf whose light cannot leave the scene
-///    (engine/connectivity.h) in a scene where no sink can be seen and no
-///    patch neither reflects nor emits (it is no link's sender) must
+///    (engine/connectivity.h) and that sees no sink and no patch that
+///    neither reflects nor emits (it is no link's sender), "sees none"
+///    proven by a closed loop between them (solver/closed_rows.h), must
 ///    gather exactly 1 for B = 1 everywhere; its deficit (the refinement
 ///    error of its ancestors' links, amplified 1 / (1 - rho) in a white
 ///    furnace) is added in proportion to what its ancestors' links bring.

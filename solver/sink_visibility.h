@@ -4,9 +4,9 @@
 /// receives (SPEC). The outer side of a room lit inside, with everything
 /// else in the room, and the inner side of a pillar lit outside, with
 /// nothing in it, receive nothing: the solver makes no node for them, and
-/// a scene with no visible sink at all lets its escape-free patches (light
-/// that cannot leave the scene, engine/connectivity.h) know that their form
-/// factors to the lit patches sum to 1 (the hierarchical solver's row sums).
+/// an escape-free patch (light that cannot leave the scene,
+/// engine/connectivity.h) that sees no visible sink knows that its form
+/// factors to the lit patches sum to 1 (solver/closed_rows.h).
 ///
 /// Rule (sufficient): the segment is on a simple loop L of known orientation
 /// (engine/connectivity.h) and
@@ -18,7 +18,9 @@
 ///  - the unlit side faces L's interior, no segment not on L has an
 ///    endpoint inside L or touches L, and no side of L facing its interior
 ///    is lit.
-/// Point-in-polygon by crossing number; a point within rounding of L's
+/// The sides' places against L: solver/loop_sides.h, with a segment in line
+/// with an edge of L counted as touching it (kept for its results, see
+/// polygon_tests.h's meets_or_in_line). A point within rounding of L's
 /// boundary counts as touching (then the sink is kept: not proven).
 /// Cost: O((segments off L) x |L|) per loop with unlit sides, skipped
 /// (sinks kept) beyond 1e8 tests in all. A round room of 10^5 walls and

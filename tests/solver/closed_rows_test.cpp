@@ -1,0 +1,166 @@
+// Which patches' rows of form factors sum to 1 (solver/closed_rows.h): a
+// patch whose light cannot leave the scene and that no closed loop keeps
+// apart from every side that sends nothing (visible sinks, inert patches)
+// is left open; one that a loop keeps apart from all of them is closed.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "engine/connectivity.h"
+#include "engine/scene.h"
+#include "solver/closed_rows.h"
+#include "solver/sink_visibility.h"
+
+using namespace flatrad;
+
+namespace {
+
+struct Rows {
+    std::vector<char> closed, dark;  // closed per patch; dark per segment side
+};
+
+// The rule's inputs as the hierarchical solver makes them.
+Rows rows_of(const Scene& s) {
+    const Connectivity conn = scene_connectivity(s);
+    Rows r;
+    std::vector<char> inert(s.patches.size(), 0);
+    for (size_t p = 0; p < s.patches.size(); ++p) {
+        const Material& m = s.materials[static_cast<size_t>(s.patches[p].material)];
+        bool sends = false;
+        for (double v : m.reflectance) sends = sends || v > 0;
+        for (double v : m.emission) sends = sends || v > 0;
+        inert[p] = sends ? 0 : 1;
+    }
+    r.dark = visible_sinks(s, conn);
+    for (size_t p = 0; p < s.patches.size(); ++p)
+        if (inert[p]) r.dark[2 * static_cast<size_t>(s.patches[p].segment) + (s.patches[p].lit_left ? 0 : 1)] = 1;
+    r.closed = closed_rows(s, conn, escape_free_patches(s, conn), visible_sinks(s, conn), inert);
+    return r;
+}
+
+// Closed rows of the patches of one surface.
+int closed_on(const Scene& s, const Rows& r, const std::string& surface) {
+    int n = 0;
+    for (size_t p = 0; p < s.patches.size(); ++p)
+        if (s.surfaces[static_cast<size_t>(s.patches[p].surface)].name == surface) n += r.closed[p];
+    return n;
+}
+
+const char* materials = R"("materials":{"w":{"reflectance":0.9},"l":{"emission":1},"b":{"reflectance":0}})";
+
+Scene scene_of(const std::string& surfaces) {
+    return parse_scene(std::string(R"({"flatrad":1,)") + materials + R"(,"surfaces":[)" + surfaces + "]}", "rows.json");
+}
+
+const std::string room = R"({"name":"room","material":"w","closed":true,"side":"in","points":[[0,0],[4,0],[4,3],[0,3]]})";
+const std::string room2 = R"({"name":"room2","material":"w","closed":true,"side":"in","points":[[6,0],[9,0],[9,3],[6,3]]})";
+
+// Whether segment g properly crosses the open segment p -> q (touching at an
+// end does not count: the sampled points lie inside their segments).
+bool blocks(const Segment& g, Vec2 p, Vec2 q) {
+    const double o1 = orient(g.a, g.b, p), o2 = orient(g.a, g.b, q);
+    const double o3 = orient(p, q, g.a), o4 = orient(p, q, g.b);
+    return ((o1 > 0 && o2 < 0) || (o1 < 0 && o2 > 0)) && ((o3 > 0 && o4 < 0) || (o3 < 0 && o4 > 0));
+}
+
+}  // namespace
+
+TEST_CASE("closed rows: a lamp through a room's wall leaves the rows inside closed") {
+    // The lamp's outer part sees the walls' outer sides (sinks): no row
+    // closed before, for the whole scene. The loop keeps the walls' inner
+    // sides apart from those sinks.
+    const Scene s = scene_of(room + R"(,{"name":"lamp","material":"l","side":"both","points":[[3.5,1],[4.5,1]]})");
+    const Rows r = rows_of(s);
+    CHECK(closed_on(s, r, "room") == 4);
+    CHECK(closed_on(s, r, "lamp") == 0);  // its outer part sees out
+}
+
+TEST_CASE("closed rows: two rooms each hide the other's outer sides") {
+    // Each room's outer sides are kept as visible sinks (the other room lies
+    // outside it), but no patch inside either room can see them.
+    const Scene s = scene_of(room + "," + room2 + R"(,{"name":"lamp","material":"l","side":"both","points":[[1,1],[2,1]]})");
+    const Rows r = rows_of(s);
+    int dark = 0;
+    for (char d : r.dark) dark += d;
+    CHECK(dark == 8);
+    CHECK(closed_on(s, r, "room") == 4);
+    CHECK(closed_on(s, r, "room2") == 4);
+    CHECK(closed_on(s, r, "lamp") == 2);
+}
+
+TEST_CASE("closed rows: what sends nothing in a room opens that room's rows, not the other's") {
+    for (const std::string dark : {R"({"name":"plate","material":"w","side":"left","points":[[1,2],[2,2]]})",
+                                   R"({"name":"plate","material":"b","side":"both","points":[[1,2],[2,2]]})"}) {
+        CAPTURE(dark);
+        const Scene s = scene_of(room + "," + room2 + "," + dark +
+                                 R"(,{"name":"lamp","material":"l","side":"both","points":[[7,1],[8,1]]})");
+        const Rows r = rows_of(s);
+        CHECK(closed_on(s, r, "room") == 0);
+        CHECK(closed_on(s, r, "room2") == 4);
+        CHECK(closed_on(s, r, "lamp") == 2);
+    }
+    // With nothing dark, every escape-free row closes, as before.
+    const Scene s = scene_of(room + R"(,{"name":"lamp","material":"l","side":"both","points":[[1,1],[2,1]]})");
+    const Rows r = rows_of(s);
+    CHECK(closed_on(s, r, "room") == 4);
+    CHECK(closed_on(s, r, "lamp") == 2);
+}
+
+TEST_CASE("closed rows: no closed row sees a side that sends nothing (sampled lines)") {
+    // Random scenes: a room, sometimes a second one, sticks inside, outside
+    // and through the walls, one-sided plates (their backs are sinks) and
+    // black plates. For every closed patch and every dark side, lines
+    // between random points of the two that leave the patch's lit side and
+    // reach the dark side's face must each cross some other segment; one
+    // free line is a closed row that sees what its links miss.
+    std::mt19937 rng(42);
+    std::uniform_real_distribution<double> U(0, 1);
+    int closed_total = 0, dark_total = 0, lines = 0;
+    for (int trial = 0; trial < 60; ++trial) {
+        std::string surfaces = room;
+        if (U(rng) < 0.5) surfaces += "," + room2;
+        const int n = 1 + static_cast<int>(U(rng) * 6);
+        for (int k = 0; k < n; ++k) {
+            const double x = -1 + 11 * U(rng), y = -0.5 + 4 * U(rng), a = 6.3 * U(rng), len = 0.3 + 1.5 * U(rng);
+            const double r = U(rng);
+            const char* material = r < 0.2 ? "b" : (r < 0.4 ? "l" : "w");
+            const char* side = U(rng) < 0.4 ? "left" : "both";
+            surfaces += R"(,{"name":"s)" + std::to_string(k) + R"(","material":")" + material + R"(","side":")" + side +
+                        R"(","points":[[)" + std::to_string(x) + "," + std::to_string(y) + "],[" +
+                        std::to_string(x + len * std::cos(a)) + "," + std::to_string(y + len * std::sin(a)) + "]]}";
+        }
+        const Scene s = scene_of(surfaces);
+        const Rows r = rows_of(s);
+        for (size_t p = 0; p < s.patches.size(); ++p) {
+            if (!r.closed[p]) continue;
+            ++closed_total;
+            const Segment P = s.patches[p].oriented(s.segments);
+            const Vec2 nP = P.left_normal();
+            for (size_t x = 0; x < r.dark.size(); ++x) {
+                if (!r.dark[x]) continue;
+                ++dark_total;
+                const size_t seg = x / 2;
+                const Segment& D0 = s.segments[seg].seg;
+                const Segment D = x % 2 == 0 ? D0 : D0.reversed();  // the dark side on its left
+                const Vec2 nD = D.left_normal();
+                for (int k = 0; k < 64; ++k) {
+                    const Vec2 p0 = P.a + (0.02 + 0.96 * U(rng)) * (P.b - P.a);
+                    const Vec2 q0 = D.a + (0.02 + 0.96 * U(rng)) * (D.b - D.a);
+                    if (dot(q0 - p0, nP) <= 0 || dot(p0 - q0, nD) <= 0) continue;
+                    ++lines;
+                    bool blocked = false;
+                    for (size_t g = 0; g < s.segments.size() && !blocked; ++g)
+                        if (g != static_cast<size_t>(s.patches[p].segment) && g != seg) blocked = blocks(s.segments[g].seg, p0, q0);
+                    CHECK_MESSAGE(blocked, "trial ", trial, " patch ", p, " sees dark side ", x);
+                }
+            }
+        }
+    }
+    // The check saw closed rows facing dark sides (the rule did something).
+    CHECK(closed_total > 100);
+    CHECK(lines > 1000);
+    MESSAGE("closed rows ", closed_total, ", pairs with a dark side ", dark_total, ", lines ", lines);
+}
