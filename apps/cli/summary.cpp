@@ -26,6 +26,16 @@ std::string channels(const std::vector<double>& v) {
 // times) means the linear solve stopped short: said, not only shown.
 constexpr double residual_warning = 1e-9;
 
+// An energy balance above this (the transport's own loss or gain, as a
+// share of the emitted light) is past the default eps's "about 1%" (README):
+// said, with what it means. Where walls reflect most of the light, the error
+// in B is larger still (the share comes back 1 / (1 - rho) times): at the
+// default eps a stiff room with a black or one-sided plate in it showed a
+// balance of 1.2-1.7e-2 and B off by 1.2-1.7e-2 (docs/solver-history.md,
+// forty-second session); the data scenes at the default eps: 2e-4 to
+// 4.2e-3.
+constexpr double balance_warning = 1e-2;
+
 double mean(const std::vector<double>& v) {
     return v.empty() ? 0.0 : std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
 }
@@ -51,6 +61,12 @@ void print_summary(std::ostream& os, const Scene& scene, const Solution& solutio
         os << fmt::format("  warning: the linear solve stopped at residual {:.3g}, short of its target; reflectance "
                           "near 1 makes the system stiff, and B may be off by about the residual over (1 - rho)\n",
                           s.residual);
+    const double worst_balance = t.balance.empty() ? 0.0 : *std::max_element(t.balance.begin(), t.balance.end());
+    if (worst_balance > balance_warning)
+        os << fmt::format("  warning: energy balance {:.3g}: the solution loses or makes that share of the emitted "
+                          "light, and B may be off by as much or more where surfaces reflect most of it; a smaller "
+                          "--eps tightens it\n",
+                          worst_balance);
 
     std::vector<std::size_t> order(std::min(scene.patches.size(), solution.patches.size()));
     std::iota(order.begin(), order.end(), std::size_t{0});

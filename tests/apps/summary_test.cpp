@@ -1,5 +1,6 @@
 // apps/cli/summary.h: the summary says when the linear solve stopped short
-// of its residual, and only then.
+// of its residual, or the energy balance is off by more than the default
+// eps's accuracy, and only then.
 #include "cli/summary.h"
 
 #include <doctest/doctest.h>
@@ -30,4 +31,27 @@ TEST_CASE("summary: a residual far above the solvers' targets is warned of, a co
     sol.stats.residual = 6.65e-9;
     const std::string text = summary();
     CHECK(text.find("warning: the linear solve stopped at residual 6.65e-09") != std::string::npos);
+}
+
+TEST_CASE("summary: an energy balance past 1e-2 is warned of, a smaller one is not") {
+    const Scene s = parse_scene(R"({"flatrad":1,"materials":{"w":{"reflectance":[0.5,0.5,0.5]},"l":{"emission":1}},
+      "surfaces":[{"name":"room","material":"w","closed":true,"side":"in","points":[[0,0],[2,0],[2,1],[0,1]]},
+                  {"name":"lamp","material":"l","side":"both","points":[[0.5,0.5],[1.5,0.6]]}]})",
+                                "room.json");
+    Solution sol = solve_exact(s, {2, 1});
+    const auto summary = [&] {
+        std::ostringstream os;
+        print_summary(os, s, sol, "");
+        return os.str();
+    };
+    REQUIRE(sol.totals.balance.size() == 3);
+    for (double b : sol.totals.balance) REQUIRE(b < 1e-12);  // the exact solver conserves energy
+    CHECK(summary().find("warning") == std::string::npos);
+    // The data scenes' largest at the default eps (furnished_room), in one
+    // channel: no warning.
+    sol.totals.balance[1] = 4.2e-3;
+    CHECK(summary().find("warning") == std::string::npos);
+    // A stiff room with a black plate at the default eps, in one channel.
+    sol.totals.balance[2] = 1.2e-2;
+    CHECK(summary().find("warning: energy balance 0.012:") != std::string::npos);
 }
