@@ -523,9 +523,6 @@ struct LinkError {
     bool split_r = true;  // the receiver's side makes most of it
 };
 
-// What the scene's connectivity says (engine/connectivity.h, solver/rooms.h,
-// solver/sink_visibility.h): computed beside the hierarchy (see
-// HierarchicalSolver's members).
 // Whether a patch of material m sends anything: it reflects or emits in
 // some channel (an element's can_send; a patch that does not, inert, is no
 // link's sender).
@@ -534,6 +531,9 @@ bool sends(const Material& m) {
            *std::max_element(m.emission.begin(), m.emission.end()) > 0;
 }
 
+// What the scene's connectivity says (engine/connectivity.h, solver/rooms.h,
+// solver/sink_visibility.h, solver/closed_rows.h): computed beside the
+// hierarchy (see HierarchicalSolver's members).
 struct SceneFacts {
     Connectivity conn;
     std::vector<char> escape_free;   // per patch
