@@ -167,12 +167,15 @@
 ///    stats.iterations the longest run's operator applications. The
 ///    residual is then checked on the whole operator.
 ///  - Row sums: a leaf whose light cannot leave the scene
-///    (engine/connectivity.h) and that sees no sink and no patch that
-///    neither reflects nor emits (it is no link's sender), "sees none"
-///    proven by a closed loop between them (solver/closed_rows.h), must
-///    gather exactly 1 for B = 1 everywhere; its deficit (the refinement
-///    error of its ancestors' links, amplified 1 / (1 - rho) in a white
-///    furnace) is added in proportion to what its ancestors' links bring.
+///    (engine/connectivity.h) and that sees no sink, "sees none" proven by
+///    a closed loop between them (solver/closed_rows.h), must gather
+///    exactly 1 for B = 1 everywhere; its deficit (the refinement error of
+///    its ancestors' links, amplified 1 / (1 - rho) in a white furnace) is
+///    added in proportion to what its ancestors' links bring. A patch that
+///    neither reflects nor emits (inert) and that such a row may see is made
+///    a sender: its links carry 0 in the solve and count in the rows, and
+///    the refinement takes its leaves at the scene's mean leaf value
+///    (refinement_values).
 ///  - Pay for what is used: light-flow reachability over the links
 ///    (solver/reachability.h, Boost.Graph BFS): links whose sender no
 ///    emitter's light reaches are dropped, patches none of whose leaves is

@@ -1,7 +1,7 @@
 // Which patches' rows of form factors sum to 1 (solver/closed_rows.h): a
-// patch whose light cannot leave the scene and that no closed loop keeps
-// apart from every side that sends nothing (visible sinks, inert patches)
-// is left open; one that a loop keeps apart from all of them is closed.
+// patch whose light cannot leave the scene is closed when closed loops keep
+// it apart from every visible sink, and an inert patch (neither reflects
+// nor emits) that a closed row may see is made a sender.
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -19,7 +19,8 @@ using namespace flatrad;
 namespace {
 
 struct Rows {
-    std::vector<char> closed, dark;  // closed per patch; dark per segment side
+    std::vector<char> closed, sends;  // per patch: the row closes; an inert patch is made a sender
+    std::vector<char> dark;           // per segment side: sends nothing (a visible sink, an inert patch not made a sender)
 };
 
 // The rule's inputs as the hierarchical solver makes them.
@@ -34,20 +35,26 @@ Rows rows_of(const Scene& s) {
         for (double v : m.emission) sends = sends || v > 0;
         inert[p] = sends ? 0 : 1;
     }
+    const ClosedRows c = closed_rows(s, conn, escape_free_patches(s, conn), visible_sinks(s, conn), inert);
+    r.closed = c.closed;
+    r.sends = c.inert_sends;
     r.dark = visible_sinks(s, conn);
-    for (size_t p = 0; p < s.patches.size(); ++p)
-        if (inert[p]) r.dark[2 * static_cast<size_t>(s.patches[p].segment) + (s.patches[p].lit_left ? 0 : 1)] = 1;
-    r.closed = closed_rows(s, conn, escape_free_patches(s, conn), visible_sinks(s, conn), inert);
+    for (size_t p = 0; p < s.patches.size(); ++p) {
+        CHECK((c.inert_sends[p] == 0 || inert[p]));  // only inert patches are made senders
+        if (inert[p] && !c.inert_sends[p])
+            r.dark[2 * static_cast<size_t>(s.patches[p].segment) + (s.patches[p].lit_left ? 0 : 1)] = 1;
+    }
     return r;
 }
 
-// Closed rows of the patches of one surface.
-int closed_on(const Scene& s, const Rows& r, const std::string& surface) {
+// Closed rows, or inert patches made senders, among one surface's patches.
+int count_on(const Scene& s, const std::vector<char>& per_patch, const std::string& surface) {
     int n = 0;
     for (size_t p = 0; p < s.patches.size(); ++p)
-        if (s.surfaces[static_cast<size_t>(s.patches[p].surface)].name == surface) n += r.closed[p];
+        if (s.surfaces[static_cast<size_t>(s.patches[p].surface)].name == surface) n += per_patch[p];
     return n;
 }
+int closed_on(const Scene& s, const Rows& r, const std::string& surface) { return count_on(s, r.closed, surface); }
 
 const char* materials = R"("materials":{"w":{"reflectance":0.9},"l":{"emission":1},"b":{"reflectance":0}})";
 
@@ -91,22 +98,38 @@ TEST_CASE("closed rows: two rooms each hide the other's outer sides") {
     CHECK(closed_on(s, r, "lamp") == 2);
 }
 
-TEST_CASE("closed rows: what sends nothing in a room opens that room's rows, not the other's") {
-    for (const std::string dark : {R"({"name":"plate","material":"w","side":"left","points":[[1,2],[2,2]]})",
-                                   R"({"name":"plate","material":"b","side":"both","points":[[1,2],[2,2]]})"}) {
-        CAPTURE(dark);
-        const Scene s = scene_of(room + "," + room2 + "," + dark +
-                                 R"(,{"name":"lamp","material":"l","side":"both","points":[[7,1],[8,1]]})");
-        const Rows r = rows_of(s);
-        CHECK(closed_on(s, r, "room") == 0);
-        CHECK(closed_on(s, r, "room2") == 4);
-        CHECK(closed_on(s, r, "lamp") == 2);
-    }
+TEST_CASE("closed rows: a sink in a room opens that room's rows, not the other's") {
+    const std::string lamp2 = R"(,{"name":"lamp","material":"l","side":"both","points":[[7,1],[8,1]]})";
+    const std::string one_sided = R"(,{"name":"plate","material":"w","side":"left","points":[[1,2],[2,2]]})";
+    const Scene s = scene_of(room + "," + room2 + one_sided + lamp2);
+    const Rows r = rows_of(s);
+    CHECK(closed_on(s, r, "room") == 0);
+    CHECK(closed_on(s, r, "room2") == 4);
+    CHECK(closed_on(s, r, "lamp") == 2);
     // With nothing dark, every escape-free row closes, as before.
-    const Scene s = scene_of(room + R"(,{"name":"lamp","material":"l","side":"both","points":[[1,1],[2,1]]})");
+    const Scene one = scene_of(room + R"(,{"name":"lamp","material":"l","side":"both","points":[[1,1],[2,1]]})");
+    const Rows q = rows_of(one);
+    CHECK(closed_on(one, q, "room") == 4);
+    CHECK(closed_on(one, q, "lamp") == 2);
+}
+
+TEST_CASE("closed rows: an inert patch seen from a closed row is made a sender, one seen from none is not") {
+    const std::string lamp2 = R"(,{"name":"lamp","material":"l","side":"both","points":[[7,1],[8,1]]})";
+    const std::string black = R"(,{"name":"black","material":"b","side":"both","points":[[1,1],[2,1]]})";
+    // A black plate in room 1: its rows close, the plate sends.
+    const Scene s = scene_of(room + "," + room2 + black + lamp2);
     const Rows r = rows_of(s);
     CHECK(closed_on(s, r, "room") == 4);
-    CHECK(closed_on(s, r, "lamp") == 2);
+    CHECK(closed_on(s, r, "room2") == 4);
+    CHECK(count_on(s, r.sends, "black") == 2);
+    // With a one-sided plate beside it, room 1's rows stay open, so no
+    // closed row sees the black plate: it sends nothing, as before.
+    const Scene t = scene_of(room + "," + room2 + black +
+                             R"(,{"name":"plate","material":"w","side":"left","points":[[1,2],[2,2]]})" + lamp2);
+    const Rows q = rows_of(t);
+    CHECK(closed_on(t, q, "room") == 0);
+    CHECK(closed_on(t, q, "room2") == 4);
+    CHECK(count_on(t, q.sends, "black") == 0);
 }
 
 TEST_CASE("closed rows: no closed row sees a side that sends nothing (sampled lines)") {
@@ -118,7 +141,7 @@ TEST_CASE("closed rows: no closed row sees a side that sends nothing (sampled li
     // free line is a closed row that sees what its links miss.
     std::mt19937 rng(42);
     std::uniform_real_distribution<double> U(0, 1);
-    int closed_total = 0, dark_total = 0, lines = 0;
+    int closed_total = 0, dark_total = 0, lines = 0, senders = 0;
     for (int trial = 0; trial < 60; ++trial) {
         std::string surfaces = room;
         if (U(rng) < 0.5) surfaces += "," + room2;
@@ -134,6 +157,7 @@ TEST_CASE("closed rows: no closed row sees a side that sends nothing (sampled li
         }
         const Scene s = scene_of(surfaces);
         const Rows r = rows_of(s);
+        for (char c : r.sends) senders += c;
         for (size_t p = 0; p < s.patches.size(); ++p) {
             if (!r.closed[p]) continue;
             ++closed_total;
@@ -159,8 +183,11 @@ TEST_CASE("closed rows: no closed row sees a side that sends nothing (sampled li
             }
         }
     }
-    // The check saw closed rows facing dark sides (the rule did something).
+    // The check saw closed rows facing dark sides (the rule did something),
+    // and inert patches made senders.
     CHECK(closed_total > 100);
     CHECK(lines > 1000);
-    MESSAGE("closed rows ", closed_total, ", pairs with a dark side ", dark_total, ", lines ", lines);
+    CHECK(senders > 10);
+    MESSAGE("closed rows ", closed_total, ", pairs with a dark side ", dark_total, ", lines ", lines,
+            ", inert patches made senders ", senders);
 }
