@@ -663,13 +663,17 @@ public:
         // can_send): a row that sees it misses what it absorbs, as with a
         // sink. (Closing such rows to 1 gave that light back to the walls:
         // a black plate in a white room was not there at all.) Rows close
-        // where a closed loop keeps the visible sinks out of sight, and an
-        // inert patch that such a row may see is made a sender
-        // (solver/closed_rows.h; gather_from_children, refinement_values).
+        // where a closed loop keeps such sides out of sight, or where they
+        // are made senders (solver/closed_rows.h; build_tree,
+        // gather_from_children, refinement_values).
         const bool inert = std::find(facts.inert.begin(), facts.inert.end(), 1) != facts.inert.end();
         m_closed_patch = std::move(facts.rows.closed);
         m_inert_sends = std::move(facts.rows.inert_sends);
-        m_any_inert_sends = std::find(m_inert_sends.begin(), m_inert_sends.end(), 1) != m_inert_sends.end();
+        m_sink_sends = std::move(facts.rows.sink_sends);
+        m_made_senders = std::find(m_inert_sends.begin(), m_inert_sends.end(), 1) != m_inert_sends.end() ||
+                            std::find(m_sink_sends.begin(), m_sink_sends.end(), 1) != m_sink_sends.end();
+        m_black.reflectance.assign(static_cast<size_t>(m_C), 0.0);
+        m_black.emission.assign(static_cast<size_t>(m_C), 0.0);
         m_convex_room = o.convex_room_shortcut && m_unblockable && !sinks && !inert &&
                         std::find(m_escape_free.begin(), m_escape_free.end(), 0) == m_escape_free.end();
     }
@@ -678,6 +682,7 @@ public:
 
 private:
     const Material& material(int patch) const {
+        if (static_cast<size_t>(patch) >= m_scene.patches.size()) return m_black;  // a sink made a sender
         return m_scene.materials[static_cast<size_t>(m_scene.patches[static_cast<size_t>(patch)].material)];
     }
     double rho(int node, int c) const {
@@ -923,8 +928,14 @@ private:
     // ancestors' part of that sum; 0 for leaves not known to be closed.
     std::vector<double> m_deficit, m_anc_sum, m_own_sum;
     std::vector<char> m_closed_patch;
-    std::vector<char> m_inert_sends;  // per patch (solver/closed_rows.h)
-    bool m_any_inert_sends = false;
+    // Sides that send nothing made senders (solver/closed_rows.h): inert
+    // patches, per patch, and visible sinks, per segment side; such a sink
+    // is an element of a patch of its own, numbered from the scene's patch
+    // count on (m_black, never in the result's patches).
+    std::vector<char> m_inert_sends, m_sink_sends;
+    bool m_made_senders = false;
+    Material m_black;
+    int m_sink_patches = 0;
     std::vector<char> m_escape_free;   // per patch (engine/connectivity.h)
     std::vector<char> m_visible_sink;  // per segment side (solver/sink_visibility.h)
     std::vector<int> m_side_room;      // per segment side (solver/rooms.h)
@@ -1130,7 +1141,8 @@ void HierarchicalSolver::build_tree() {
             const SceneSegment& ss = m_scene.segments[static_cast<size_t>(s)];
             for (int side = 0; side < 2; ++side) {
                 const bool lit = side == 0 ? ss.lit_left : ss.lit_right;
-                if (!lit && !m_visible_sink[2 * static_cast<size_t>(s) + static_cast<size_t>(side)]) continue;
+                const size_t x = 2 * static_cast<size_t>(s) + static_cast<size_t>(side);
+                if (!lit && !m_visible_sink[x]) continue;
                 Node n;
                 n.parent = id;
                 n.hnode = h;
@@ -1148,6 +1160,9 @@ void HierarchicalSolver::build_tree() {
                                       ? first_patch[static_cast<size_t>(s)]
                                       : second_patch[static_cast<size_t>(s)];
                     n.patch = p;
+                } else if (m_sink_sends[x]) {
+                    n.kind = Kind::Element;
+                    n.patch = static_cast<int>(m_scene.patches.size() + m_sink_patches++);
                 } else {
                     n.kind = Kind::Sink;
                 }
@@ -1157,7 +1172,13 @@ void HierarchicalSolver::build_tree() {
         m_nodes[static_cast<size_t>(id)].child = first;
         m_nodes[static_cast<size_t>(id)].nchild = static_cast<int>(m_nodes.size()) - first;
     }
-    m_patch_root.assign(m_scene.patches.size(), -1);
+    // The sinks made senders: patches of their own, whose light cannot be
+    // closed (they carry 0) and that send.
+    const size_t all_patches = m_scene.patches.size() + static_cast<size_t>(m_sink_patches);
+    m_escape_free.resize(all_patches, 0);
+    m_closed_patch.resize(all_patches, 0);
+    m_inert_sends.resize(all_patches, 1);
+    m_patch_root.assign(all_patches, -1);
     for (size_t k = 0; k < m_nodes.size(); ++k)
         if (m_nodes[k].kind == Kind::Element) m_patch_root[static_cast<size_t>(m_nodes[k].patch)] = static_cast<int>(k);
     // Directional tables for the clusters that are not hierarchy leaves
@@ -2501,10 +2522,11 @@ std::vector<double> HierarchicalSolver::leaf_guess() const {
 // One refinement round against leaf values `leaf_bmax` (max over channels),
 // with eps_abs from `exitant_power` where that is >= 0 (else from the
 // leaf values); returns whether a link split.
-// Leaf values for the refinement's error estimates. An inert patch made a
-// sender (m_inert_sends) carries 0 in the solve, but its links are part of
-// the closed rows it is seen from: an error in their F moves the deficit
-// given back to a row, and with it light of about the row's surroundings'
+// Leaf values for the refinement's error estimates. A side that sends
+// nothing made a sender (an inert patch, or a sink as a patch of its own:
+// m_inert_sends) carries 0 in the solve, but its links are part of the
+// closed rows it is seen from: an error in their F moves the deficit given
+// back to a row, and with it light of about the row's surroundings'
 // radiosity. So its leaves take the scene's mean leaf value (by length)
 // here, and its links are refined as if it shone at that. (Refined at its
 // own 0, a black plate's links stayed as coarse as its first link, and the
@@ -2512,7 +2534,7 @@ std::vector<double> HierarchicalSolver::leaf_guess() const {
 // relative L2 against exact at the default eps, against 1.2e-2 with those
 // rows open and 1.2e-3 so.)
 std::vector<double> HierarchicalSolver::refinement_values(std::vector<double> b) const {
-    if (!m_any_inert_sends) return b;
+    if (!m_made_senders) return b;
     CompensatedSum num, den;
     for (size_t i = 0; i < b.size(); ++i) {
         const double L = m_nodes[static_cast<size_t>(m_leaves[i])].length;
@@ -3032,9 +3054,10 @@ void HierarchicalSolver::drop_dark(const std::vector<char>& reached2) {
     m_reached.assign(static_cast<size_t>(N), 0);
     for (int k = 0; k < N; ++k) m_reached[static_cast<size_t>(k)] = reached2[static_cast<size_t>(k)];
     // Patches none of whose leaves is reached.
-    std::vector<char> lit_patch(m_scene.patches.size(), 0);
+    std::vector<char> lit_patch(m_scene.patches.size() + static_cast<size_t>(m_sink_patches), 0);
     for (int leaf : m_leaves)
         if (m_reached[static_cast<size_t>(leaf)]) lit_patch[static_cast<size_t>(m_nodes[static_cast<size_t>(leaf)].patch)] = 1;
+    lit_patch.resize(m_scene.patches.size());  // (the sinks made senders are no patches of the scene)
     m_left_out = 0;
     for (char c : lit_patch) m_left_out += c ? 0 : 1;
     const size_t before = m_links.size();
@@ -3495,7 +3518,7 @@ Solution HierarchicalSolver::run() {
             for (size_t i = 0; i < e.size(); ++i)
                 for (int c = 0; c < m_C; ++c) e[i] = std::max(e[i], emission(m_leaves[i], c));
             refine(refinement_values(std::move(e)), W.value());
-        } else if (m_any_inert_sends) {
+        } else if (m_made_senders) {
             refine(refinement_values(guess), W.value());
         } else {
             refine(guess);
@@ -3522,7 +3545,7 @@ Solution HierarchicalSolver::run() {
                     bmax[i] = std::max(bmax[i], m_B[static_cast<size_t>(c)][static_cast<size_t>(m_leaves[i])]);
             progress(fmt::format("refining (pass {})", pass + 1), -1);
             bool changed = false;
-            if (m_any_inert_sends) {
+            if (m_made_senders) {
                 CompensatedSum Wb;
                 for (size_t i = 0; i < bmax.size(); ++i) Wb.add(m_nodes[static_cast<size_t>(m_leaves[i])].length * bmax[i]);
                 changed = refine(refinement_values(std::move(bmax)), Wb.value());

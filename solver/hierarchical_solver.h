@@ -167,15 +167,17 @@
 ///    stats.iterations the longest run's operator applications. The
 ///    residual is then checked on the whole operator.
 ///  - Row sums: a leaf whose light cannot leave the scene
-///    (engine/connectivity.h) and that sees no sink, "sees none" proven by
-///    a closed loop between them (solver/closed_rows.h), must gather
+///    (engine/connectivity.h) and that sees only link senders must gather
 ///    exactly 1 for B = 1 everywhere; its deficit (the refinement error of
 ///    its ancestors' links, amplified 1 / (1 - rho) in a white furnace) is
-///    added in proportion to what its ancestors' links bring. A patch that
-///    neither reflects nor emits (inert) and that such a row may see is made
-///    a sender: its links carry 0 in the solve and count in the rows, and
-///    the refinement takes its leaves at the scene's mean leaf value
-///    (refinement_values).
+///    added in proportion to what its ancestors' links bring. Sides that
+///    send nothing (visible sinks, patches that neither reflect nor emit)
+///    keep the rows that may see them open, unless a closed loop keeps them
+///    apart, or a stiff row (reflectance >= 0.95) may see them: then they
+///    are made senders that carry 0 (a sink becomes an element of a patch
+///    of its own, not in the result), their links count in the rows, and
+///    the refinement takes their leaves at the scene's mean leaf value
+///    (refinement_values; solver/closed_rows.h).
 ///  - Pay for what is used: light-flow reachability over the links
 ///    (solver/reachability.h, Boost.Graph BFS): links whose sender no
 ///    emitter's light reaches are dropped, patches none of whose leaves is

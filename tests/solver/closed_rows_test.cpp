@@ -1,7 +1,8 @@
 // Which patches' rows of form factors sum to 1 (solver/closed_rows.h): a
-// patch whose light cannot leave the scene is closed when closed loops keep
-// it apart from every visible sink, and an inert patch (neither reflects
-// nor emits) that a closed row may see is made a sender.
+// patch whose light cannot leave the scene closes when closed loops keep it
+// apart from every side that sends nothing (visible sinks, inert patches),
+// or when each such side it may see is made a sender, which happens where
+// some row that may see it is stiff (reflectance 0.95 or more).
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -20,7 +21,8 @@ namespace {
 
 struct Rows {
     std::vector<char> closed, sends;  // per patch: the row closes; an inert patch is made a sender
-    std::vector<char> dark;           // per segment side: sends nothing (a visible sink, an inert patch not made a sender)
+    std::vector<char> sink_sends;     // per segment side: a visible sink made a sender
+    std::vector<char> dark;           // per segment side: sends nothing (not made a sender)
 };
 
 // The rule's inputs as the hierarchical solver makes them.
@@ -38,7 +40,12 @@ Rows rows_of(const Scene& s) {
     const ClosedRows c = closed_rows(s, conn, escape_free_patches(s, conn), visible_sinks(s, conn), inert);
     r.closed = c.closed;
     r.sends = c.inert_sends;
+    r.sink_sends = c.sink_sends;
     r.dark = visible_sinks(s, conn);
+    for (size_t x = 0; x < r.dark.size(); ++x) {
+        CHECK((c.sink_sends[x] == 0 || r.dark[x]));  // only visible sinks are made senders
+        if (c.sink_sends[x]) r.dark[x] = 0;
+    }
     for (size_t p = 0; p < s.patches.size(); ++p) {
         CHECK((c.inert_sends[p] == 0 || inert[p]));  // only inert patches are made senders
         if (inert[p] && !c.inert_sends[p])
@@ -56,7 +63,8 @@ int count_on(const Scene& s, const std::vector<char>& per_patch, const std::stri
 }
 int closed_on(const Scene& s, const Rows& r, const std::string& surface) { return count_on(s, r.closed, surface); }
 
-const char* materials = R"("materials":{"w":{"reflectance":0.9},"l":{"emission":1},"b":{"reflectance":0}})";
+// w: stiff walls (0.99); m: walls below the stiffness bar (0.9).
+const char* materials = R"("materials":{"w":{"reflectance":0.99},"m":{"reflectance":0.9},"l":{"emission":1},"b":{"reflectance":0}})";
 
 Scene scene_of(const std::string& surfaces) {
     return parse_scene(std::string(R"({"flatrad":1,)") + materials + R"(,"surfaces":[)" + surfaces + "]}", "rows.json");
@@ -98,38 +106,48 @@ TEST_CASE("closed rows: two rooms each hide the other's outer sides") {
     CHECK(closed_on(s, r, "lamp") == 2);
 }
 
-TEST_CASE("closed rows: a sink in a room opens that room's rows, not the other's") {
+TEST_CASE("closed rows: what sends nothing in a room below the stiffness bar opens that room's rows, not the other's") {
+    // Room 1's walls reflect 0.9: the sides there that send nothing stay
+    // as they are, and its rows stay open. Room 2 is closed.
+    const std::string room_m = R"({"name":"room","material":"m","closed":true,"side":"in","points":[[0,0],[4,0],[4,3],[0,3]]})";
     const std::string lamp2 = R"(,{"name":"lamp","material":"l","side":"both","points":[[7,1],[8,1]]})";
-    const std::string one_sided = R"(,{"name":"plate","material":"w","side":"left","points":[[1,2],[2,2]]})";
-    const Scene s = scene_of(room + "," + room2 + one_sided + lamp2);
-    const Rows r = rows_of(s);
-    CHECK(closed_on(s, r, "room") == 0);
-    CHECK(closed_on(s, r, "room2") == 4);
-    CHECK(closed_on(s, r, "lamp") == 2);
-    // With nothing dark, every escape-free row closes, as before.
-    const Scene one = scene_of(room + R"(,{"name":"lamp","material":"l","side":"both","points":[[1,1],[2,1]]})");
+    for (const std::string dark : {R"(,{"name":"plate","material":"m","side":"left","points":[[1,2],[2,2]]})",
+                                   R"(,{"name":"plate","material":"b","side":"both","points":[[1,2],[2,2]]})"}) {
+        CAPTURE(dark);
+        const Scene s = scene_of(room_m + "," + room2 + dark + lamp2);
+        const Rows r = rows_of(s);
+        CHECK(closed_on(s, r, "room") == 0);
+        CHECK(closed_on(s, r, "room2") == 4);
+        CHECK(closed_on(s, r, "lamp") == 2);
+        for (char c : r.sends) CHECK(c == 0);
+        for (char c : r.sink_sends) CHECK(c == 0);
+    }
+    // With nothing dark, every escape-free row closes, whatever it reflects.
+    const Scene one = scene_of(room_m + R"(,{"name":"lamp","material":"l","side":"both","points":[[1,1],[2,1]]})");
     const Rows q = rows_of(one);
     CHECK(closed_on(one, q, "room") == 4);
     CHECK(closed_on(one, q, "lamp") == 2);
 }
 
-TEST_CASE("closed rows: an inert patch seen from a closed row is made a sender, one seen from none is not") {
+TEST_CASE("closed rows: in a stiff room, what sends nothing and is seen is made a sender, and the rows close") {
     const std::string lamp2 = R"(,{"name":"lamp","material":"l","side":"both","points":[[7,1],[8,1]]})";
-    const std::string black = R"(,{"name":"black","material":"b","side":"both","points":[[1,1],[2,1]]})";
     // A black plate in room 1: its rows close, the plate sends.
-    const Scene s = scene_of(room + "," + room2 + black + lamp2);
+    const Scene s = scene_of(room + "," + room2 + R"(,{"name":"black","material":"b","side":"both","points":[[1,1],[2,1]]})" + lamp2);
     const Rows r = rows_of(s);
     CHECK(closed_on(s, r, "room") == 4);
     CHECK(closed_on(s, r, "room2") == 4);
     CHECK(count_on(s, r.sends, "black") == 2);
-    // With a one-sided plate beside it, room 1's rows stay open, so no
-    // closed row sees the black plate: it sends nothing, as before.
-    const Scene t = scene_of(room + "," + room2 + black +
-                             R"(,{"name":"plate","material":"w","side":"left","points":[[1,2],[2,2]]})" + lamp2);
+    // A one-sided plate: its back (a sink) is made a sender; the rooms'
+    // outer sides, seen from no row, stay plain sinks.
+    const Scene t = scene_of(room + "," + room2 + R"(,{"name":"plate","material":"w","side":"left","points":[[1,2],[2,2]]})" + lamp2);
     const Rows q = rows_of(t);
-    CHECK(closed_on(t, q, "room") == 0);
+    CHECK(closed_on(t, q, "room") == 4);
     CHECK(closed_on(t, q, "room2") == 4);
-    CHECK(count_on(t, q.sends, "black") == 0);
+    CHECK(closed_on(t, q, "plate") == 1);
+    int sinks_sending = 0;
+    for (char c : q.sink_sends) sinks_sending += c;
+    CHECK(sinks_sending == 1);
+    CHECK(q.sink_sends[2 * 8 + 1] == 1);  // segment 8 is the plate, lit on its left
 }
 
 TEST_CASE("closed rows: no closed row sees a side that sends nothing (sampled lines)") {
@@ -149,7 +167,7 @@ TEST_CASE("closed rows: no closed row sees a side that sends nothing (sampled li
         for (int k = 0; k < n; ++k) {
             const double x = -1 + 11 * U(rng), y = -0.5 + 4 * U(rng), a = 6.3 * U(rng), len = 0.3 + 1.5 * U(rng);
             const double r = U(rng);
-            const char* material = r < 0.2 ? "b" : (r < 0.4 ? "l" : "w");
+            const char* material = r < 0.2 ? "b" : (r < 0.4 ? "l" : (r < 0.7 ? "w" : "m"));
             const char* side = U(rng) < 0.4 ? "left" : "both";
             surfaces += R"(,{"name":"s)" + std::to_string(k) + R"(","material":")" + material + R"(","side":")" + side +
                         R"(","points":[[)" + std::to_string(x) + "," + std::to_string(y) + "],[" +
@@ -158,6 +176,7 @@ TEST_CASE("closed rows: no closed row sees a side that sends nothing (sampled li
         const Scene s = scene_of(surfaces);
         const Rows r = rows_of(s);
         for (char c : r.sends) senders += c;
+        for (char c : r.sink_sends) senders += c;
         for (size_t p = 0; p < s.patches.size(); ++p) {
             if (!r.closed[p]) continue;
             ++closed_total;
@@ -184,10 +203,10 @@ TEST_CASE("closed rows: no closed row sees a side that sends nothing (sampled li
         }
     }
     // The check saw closed rows facing dark sides (the rule did something),
-    // and inert patches made senders.
+    // and sides that send nothing made senders.
     CHECK(closed_total > 100);
     CHECK(lines > 1000);
     CHECK(senders > 10);
     MESSAGE("closed rows ", closed_total, ", pairs with a dark side ", dark_total, ", lines ", lines,
-            ", inert patches made senders ", senders);
+            ", sides made senders ", senders);
 }
