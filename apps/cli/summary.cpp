@@ -30,10 +30,10 @@ constexpr double residual_warning = 1e-9;
 // share of the emitted light) is past the default eps's "about 1%" (README):
 // said, with what it means. Where walls reflect most of the light, the error
 // in B is larger still (the share comes back 1 / (1 - rho) times): at the
-// default eps a stiff room with a black or one-sided plate in it showed a
-// balance of 1.2-1.7e-2 and B off by 1.2-1.7e-2 (docs/solver-history.md,
-// forty-second session); the data scenes at the default eps: 2e-4 to
-// 4.2e-3.
+// default eps a room at reflectance 0.94 with a one-sided plate in it (its
+// rows open: solver/closed_rows.h) shows a balance of 1.2e-2 with B off by
+// 1.1e-2 relative L2 (docs/solver-history.md, forty-second session); the
+// data scenes at the default eps: 2e-4 to 4.2e-3.
 constexpr double balance_warning = 1e-2;
 
 double mean(const std::vector<double>& v) {

@@ -51,7 +51,8 @@ TEST_CASE("summary: an energy balance past 1e-2 is warned of, a smaller one is n
     // channel: no warning.
     sol.totals.balance[1] = 4.2e-3;
     CHECK(summary().find("warning") == std::string::npos);
-    // A stiff room with a black plate at the default eps, in one channel.
+    // A room at reflectance 0.94 with a one-sided plate at the default eps,
+    // in one channel.
     sol.totals.balance[2] = 1.2e-2;
     CHECK(summary().find("warning: energy balance 0.012:") != std::string::npos);
 }
