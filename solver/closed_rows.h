@@ -29,8 +29,8 @@
 /// Before, one sink seen from anywhere, or one inert patch anywhere, left
 /// every row open. At reflectance 0.99 and the default eps, relative L2
 /// against exact: a lamp through a wall 5.5e-2 -> 3.9e-4, a black plate in
-/// the room 1.2e-2 -> 1.2e-3, a one-sided plate (its back a sink) 1.7e-2 ->
-/// 1.7e-3 (docs/solver-history.md, forty-second session).
+/// the room 1.2e-2 -> 1.1e-3, a one-sided plate (its back a sink) 1.7e-2 ->
+/// 2.7e-3 (docs/solver-history.md, forty-second session).
 ///
 /// Cost: classifying the sides against a loop is O(segments x |L|), loops
 /// taken while that stays within 1e8 in all; then O(U x C x K) for U
