@@ -2,7 +2,7 @@
 
 #include <algorithm>
 #include <string>
-#include <unordered_set>
+#include <cstdint>
 
 #include "solver/loop_sides.h"
 
@@ -57,51 +57,82 @@ ClosedRows closed_rows(const Scene& scene, const Connectivity& conn, const std::
     r.inert_sends.assign(P, 0);
     r.sink_sends.assign(visible_sink.size(), 0);
     if (candidates.empty()) return r;
-    // Each side's class against each loop, as strings of one char per loop
-    // (dark sides with the same string are seen from the same rows: test
-    // each string once).
-    const size_t S = scene.segments.size();
-    std::vector<std::string> dark_where(dark.size()), cand_where(candidates.size());
-    if (!dark.empty()) {
-        double budget = 1e8;
-        for (const SceneLoop& L : conn.loops) {
-            if (!L.simple || L.orientation == 0) continue;
-            const double cost = static_cast<double>(S) * static_cast<double>(L.polygon.size());
-            if (cost > budget) continue;
-            budget -= cost;
-            const std::vector<LoopSide> where = loop_sides(scene, L);
-            for (size_t i = 0; i < dark.size(); ++i) dark_where[i].push_back(static_cast<char>(where[dark[i]]));
-            for (size_t i = 0; i < candidates.size(); ++i)
-                cand_where[i].push_back(static_cast<char>(where[side_of(candidates[i])]));
+    if (dark.empty()) {
+        for (size_t p : candidates) r.closed[p] = 1;
+        return r;
+    }
+    // Each side's classes against the loops, one char per loop. Sides with
+    // the same string are kept apart from the same ones, so each side holds
+    // the number of its string (the strings refined loop by loop: most
+    // sides share a few), and the pairs are tested string against string.
+    // Items: the dark sides, then the candidates (stiff ones flagged).
+    const size_t S = scene.segments.size(), D = dark.size();
+    std::vector<size_t> item_side(dark);
+    for (size_t p : candidates) item_side.push_back(side_of(p));
+    std::vector<int32_t> kind(item_side.size(), 0);
+    std::vector<std::string> strings(1);
+    double budget = 1e8;
+    for (const SceneLoop& L : conn.loops) {
+        if (!L.simple || L.orientation == 0) continue;
+        const double cost = static_cast<double>(S) * static_cast<double>(L.polygon.size());
+        if (cost > budget) continue;
+        budget -= cost;
+        const std::vector<LoopSide> where = loop_sides(scene, L);
+        std::vector<int32_t> next(strings.size() * 3, -1);  // (old string, class) -> new string
+        std::vector<std::string> refined;
+        for (size_t i = 0; i < item_side.size(); ++i) {
+            const char c = static_cast<char>(where[item_side[i]]);
+            int32_t& to = next[static_cast<size_t>(kind[i]) * 3 + static_cast<size_t>(c)];
+            if (to < 0) {
+                to = static_cast<int32_t>(refined.size());
+                refined.push_back(strings[static_cast<size_t>(kind[i])] + c);
+            }
+            kind[i] = to;
         }
-        const std::unordered_set<std::string> kinds(dark_where.begin(), dark_where.end());
-        const double K = static_cast<double>(cand_where[0].size());
-        if (static_cast<double>(kinds.size()) * static_cast<double>(candidates.size()) * K > 1e8) return r;
-        // The kinds of dark side that some stiff candidate may see are made
-        // senders; a candidate's row closes when every kind it may see is.
-        std::unordered_set<std::string> senders;
-        for (size_t i = 0; i < candidates.size() && senders.size() < kinds.size(); ++i) {
-            if (!stiff(candidates[i])) continue;
-            for (const std::string& d : kinds)
-                if (!senders.count(d) && !apart(d, cand_where[i])) senders.insert(d);
+        strings = std::move(refined);
+    }
+    // The strings of the dark sides, of the candidates, of the stiff ones.
+    std::vector<char> is_dark(strings.size(), 0), is_cand(strings.size(), 0), is_stiff(strings.size(), 0);
+    for (size_t i = 0; i < item_side.size(); ++i) {
+        const size_t k = static_cast<size_t>(kind[i]);
+        if (i < D) is_dark[k] = 1;
+        else {
+            is_cand[k] = 1;
+            if (stiff(candidates[i - D])) is_stiff[k] = 1;
         }
-        for (size_t i = 0; i < dark.size(); ++i) {
-            if (!senders.count(dark_where[i])) continue;
+    }
+    std::vector<size_t> dark_kinds, cand_kinds;
+    for (size_t k = 0; k < strings.size(); ++k) {
+        if (is_dark[k]) dark_kinds.push_back(k);
+        if (is_cand[k]) cand_kinds.push_back(k);
+    }
+    const double loops = static_cast<double>(strings[0].size());
+    if (static_cast<double>(dark_kinds.size()) * static_cast<double>(cand_kinds.size()) * loops > 1e8) return r;
+    // The kinds of dark side that some stiff candidate may see are made
+    // senders; a candidate's row closes when every kind it may see is.
+    std::vector<char> sends(strings.size(), 0);
+    for (size_t c : cand_kinds)
+        if (is_stiff[c])
+            for (size_t d : dark_kinds)
+                if (!apart(strings[d], strings[c])) sends[d] = 1;
+    std::vector<char> closes(strings.size(), 0);
+    for (size_t c : cand_kinds) {
+        closes[c] = 1;
+        for (size_t d : dark_kinds)
+            if (!sends[d] && !apart(strings[d], strings[c])) {
+                closes[c] = 0;
+                break;
+            }
+    }
+    for (size_t i = 0; i < item_side.size(); ++i) {
+        const size_t k = static_cast<size_t>(kind[i]);
+        if (i >= D) {
+            r.closed[candidates[i - D]] = closes[k];
+        } else if (sends[k]) {
             if (dark_patch[i] < 0) r.sink_sends[dark[i]] = 1;
             else r.inert_sends[static_cast<size_t>(dark_patch[i])] = 1;
         }
-        for (size_t i = 0; i < candidates.size(); ++i) {
-            bool closes = true;
-            for (const std::string& d : kinds) {
-                if (senders.count(d) || apart(d, cand_where[i])) continue;
-                closes = false;
-                break;
-            }
-            r.closed[candidates[i]] = closes ? 1 : 0;
-        }
-        return r;
     }
-    for (size_t p : candidates) r.closed[p] = 1;
     return r;
 }
 

@@ -32,12 +32,13 @@
 /// the room 1.2e-2 -> 1.1e-3, a one-sided plate (its back a sink) 1.7e-2 ->
 /// 2.7e-3 (docs/solver-history.md, forty-second session).
 ///
-/// Cost: classifying the sides against a loop is O(segments x |L|), loops
-/// taken while that stays within 1e8 in all; then O(U x C x K) for U
-/// distinct sets of classes among the sides that send nothing, C candidate
-/// patches and K loops, and beyond 1e8 no row is closed (never wrong: a row
-/// left open is only less accurate). A side made a sender costs an element
-/// tree and its links.
+/// Cost: none where nothing is dark. Else classifying the sides against a
+/// loop is O(segments x |L|), loops taken while that stays within 1e8 in
+/// all, and a hash per side and loop gives each side the number of its
+/// string of classes; then O(U x C x K) for U and C distinct strings among
+/// the dark sides and the candidates and K loops, and beyond 1e8 no row is
+/// closed (never wrong: a row left open is only less accurate). A side made
+/// a sender costs an element tree and its links.
 #include <vector>
 
 #include "engine/connectivity.h"
