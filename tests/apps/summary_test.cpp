@@ -13,46 +13,54 @@
 
 using namespace flatrad;
 
-TEST_CASE("summary: a residual far above the solvers' targets is warned of, a converged one is not") {
-    const Scene s = parse_scene(R"({"flatrad":1,"materials":{"w":{"reflectance":0.5},"l":{"emission":1}},
+namespace {
+
+// A small room's exact solution in `channels` channels (a few ulps of
+// residual, energy conserved), and its summary as the solution stands.
+struct Solved {
+    Scene scene;
+    Solution solution;
+    std::string summary() const {
+        std::ostringstream os;
+        print_summary(os, scene, solution, "");
+        return os.str();
+    }
+};
+
+Solved solved_room(const char* reflectance) {
+    Solved r{parse_scene(std::string(R"({"flatrad":1,"materials":{"w":{"reflectance":)") + reflectance +
+                             R"(},"l":{"emission":1}},
       "surfaces":[{"name":"room","material":"w","closed":true,"side":"in","points":[[0,0],[2,0],[2,1],[0,1]]},
                   {"name":"lamp","material":"l","side":"both","points":[[0.5,0.5],[1.5,0.6]]}]})",
-                                "room.json");
-    Solution sol = solve_exact(s, {2, 1});
-    const auto summary = [&] {
-        std::ostringstream os;
-        print_summary(os, s, sol, "");
-        return os.str();
-    };
-    REQUIRE(sol.stats.residual < 1e-12);  // the LU's own: a few ulps
-    CHECK(summary().find("warning") == std::string::npos);
+                         "room.json"),
+             {}};
+    r.solution = solve_exact(r.scene, {2, 1});
+    return r;
+}
+
+}  // namespace
+
+TEST_CASE("summary: a residual far above the solvers' targets is warned of, a converged one is not") {
+    Solved r = solved_room("0.5");
+    REQUIRE(r.solution.stats.residual < 1e-12);  // the LU's own: a few ulps
+    CHECK(r.summary().find("warning") == std::string::npos);
     // A GMRES run that stopped short (a stiff scene: the fuzzer's triangle
     // room at reflectance 0.999999 ended at 6.65e-9 after 8242 iterations).
-    sol.stats.residual = 6.65e-9;
-    const std::string text = summary();
-    CHECK(text.find("warning: the linear solve stopped at residual 6.65e-09") != std::string::npos);
+    r.solution.stats.residual = 6.65e-9;
+    CHECK(r.summary().find("warning: the linear solve stopped at residual 6.65e-09") != std::string::npos);
 }
 
 TEST_CASE("summary: an energy balance past 1e-2 is warned of, a smaller one is not") {
-    const Scene s = parse_scene(R"({"flatrad":1,"materials":{"w":{"reflectance":[0.5,0.5,0.5]},"l":{"emission":1}},
-      "surfaces":[{"name":"room","material":"w","closed":true,"side":"in","points":[[0,0],[2,0],[2,1],[0,1]]},
-                  {"name":"lamp","material":"l","side":"both","points":[[0.5,0.5],[1.5,0.6]]}]})",
-                                "room.json");
-    Solution sol = solve_exact(s, {2, 1});
-    const auto summary = [&] {
-        std::ostringstream os;
-        print_summary(os, s, sol, "");
-        return os.str();
-    };
-    REQUIRE(sol.totals.balance.size() == 3);
-    for (double b : sol.totals.balance) REQUIRE(b < 1e-12);  // the exact solver conserves energy
-    CHECK(summary().find("warning") == std::string::npos);
+    Solved r = solved_room("[0.5,0.5,0.5]");
+    REQUIRE(r.solution.totals.balance.size() == 3);
+    for (double b : r.solution.totals.balance) REQUIRE(b < 1e-12);  // the exact solver conserves energy
+    CHECK(r.summary().find("warning") == std::string::npos);
     // The data scenes' largest at the default eps (furnished_room), in one
     // channel: no warning.
-    sol.totals.balance[1] = 4.2e-3;
-    CHECK(summary().find("warning") == std::string::npos);
+    r.solution.totals.balance[1] = 4.2e-3;
+    CHECK(r.summary().find("warning") == std::string::npos);
     // A room at reflectance 0.94 with a one-sided plate at the default eps,
     // in one channel.
-    sol.totals.balance[2] = 1.2e-2;
-    CHECK(summary().find("warning: energy balance 0.012:") != std::string::npos);
+    r.solution.totals.balance[2] = 1.2e-2;
+    CHECK(r.summary().find("warning: energy balance 0.012:") != std::string::npos);
 }
