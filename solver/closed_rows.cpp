@@ -1,8 +1,8 @@
 #include "solver/closed_rows.h"
 
 #include <algorithm>
-#include <string>
 #include <cstdint>
+#include <string>
 
 #include "solver/loop_sides.h"
 

@@ -40,6 +40,15 @@ inline Where locate(Vec2 p, const std::vector<Vec2>& poly) {
     return inside ? Where::Inside : Where::Outside;
 }
 
+// Whether segment s and the edge a -> b cross or touch, by their four
+// orientations alone: two collinear segments count wherever they lie on
+// their shared line.
+inline bool orientations_meet(const Segment& s, Vec2 a, Vec2 b) {
+    const double o1 = orient(a, b, s.a), o2 = orient(a, b, s.b);
+    const double o3 = orient(s.a, s.b, a), o4 = orient(s.a, s.b, b);
+    return (o1 <= 0 || o2 <= 0) && (o1 >= 0 || o2 >= 0) && (o3 <= 0 || o4 <= 0) && (o3 >= 0 || o4 >= 0);
+}
+
 // Whether segment s properly crosses or touches some edge of the polygon.
 // Segments whose boxes are apart cannot meet; the test is needed for two
 // collinear ones (every orientation 0), which the orientations alone take
@@ -54,9 +63,7 @@ inline bool meets(const Segment& s, const std::vector<Vec2>& poly) {
         if (std::max(a.x, b.x) < lo_x || std::min(a.x, b.x) > hi_x || std::max(a.y, b.y) < lo_y ||
             std::min(a.y, b.y) > hi_y)
             continue;
-        const double o1 = orient(a, b, s.a), o2 = orient(a, b, s.b);
-        const double o3 = orient(s.a, s.b, a), o4 = orient(s.a, s.b, b);
-        if ((o1 <= 0 || o2 <= 0) && (o1 >= 0 || o2 >= 0) && (o3 <= 0 || o4 <= 0) && (o3 >= 0 || o4 >= 0)) return true;
+        if (orientations_meet(s, a, b)) return true;
     }
     return false;
 }
@@ -69,14 +76,11 @@ inline bool meets(const Segment& s, const std::vector<Vec2>& poly) {
 // 1.45e-3 to 2.2e-3 (docs/solver-history.md, forty-second session).
 inline bool meets_or_in_line(const Segment& s, const std::vector<Vec2>& poly) {
     const size_t n = poly.size();
-    for (size_t k = 0; k < n; ++k) {
-        const Vec2 a = poly[k], b = poly[(k + 1) % n];
-        const double o1 = orient(a, b, s.a), o2 = orient(a, b, s.b);
-        const double o3 = orient(s.a, s.b, a), o4 = orient(s.a, s.b, b);
-        if ((o1 <= 0 || o2 <= 0) && (o1 >= 0 || o2 >= 0) && (o3 <= 0 || o4 <= 0) && (o3 >= 0 || o4 >= 0)) return true;
-    }
+    for (size_t k = 0; k < n; ++k)
+        if (orientations_meet(s, poly[k], poly[(k + 1) % n])) return true;
     return false;
 }
+
 // Whether segment s passes from one side of the polygon to the other: it
 // properly crosses an edge (each strictly on both sides of the other's
 // line, beyond locate's rounding margin for s's ends), or a corner of the

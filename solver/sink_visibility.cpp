@@ -35,13 +35,15 @@ std::vector<char> visible_sinks(const Scene& scene, const Connectivity& conn) {
         // lit interior side sees the interior sinks, a lit exterior side (of
         // a non-convex loop) the exterior ones.
         bool lit_interior = false, lit_exterior = false;
-        for (int s : L.segments)
+        for (int s : L.segments) {
+            const SceneSegment& ss = scene.segments[static_cast<size_t>(s)];
             for (size_t side = 0; side < 2; ++side) {
                 const size_t x = 2 * static_cast<size_t>(s) + side;
-                const bool lit = side == 0 ? scene.segments[static_cast<size_t>(s)].lit_left : scene.segments[static_cast<size_t>(s)].lit_right;
+                const bool lit = side == 0 ? ss.lit_left : ss.lit_right;
                 lit_interior = lit_interior || (lit && where[x] == LoopSide::In);
                 lit_exterior = lit_exterior || (lit && where[x] == LoopSide::Out);
             }
+        }
         for (int s : L.segments)
             for (size_t side = 0; side < 2; ++side) {
                 const size_t x = 2 * static_cast<size_t>(s) + side;
