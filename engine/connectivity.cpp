@@ -41,16 +41,6 @@ int orient_sign(Vec2 a, Vec2 b, Vec2 c) {
     return o > bound ? 1 : (o < -bound ? -1 : 0);
 }
 
-bool boxes_apart(const Box& p, const Box& q) {
-    return p.hi.x < q.lo.x || q.hi.x < p.lo.x || p.hi.y < q.lo.y || q.hi.y < p.lo.y;
-}
-
-Box box_of(const Segment& s) {
-    Box b;
-    b.add(s);
-    return b;
-}
-
 /// The closed segments s and e certainly have no point in common. False
 /// when they cross, touch, overlap, or it is too close to call.
 bool certainly_disjoint(const Segment& s, const Segment& e) {

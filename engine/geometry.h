@@ -89,7 +89,21 @@ struct Box {
     Vec2 center() const { return (lo + hi) * 0.5; }
     Vec2 extent() const { return hi - lo; }
     double diagonal() const { return empty() ? 0.0 : norm(hi - lo); }
+    /// Whether p lies in the closed box.
+    bool holds(Vec2 p) const { return lo.x <= p.x && p.x <= hi.x && lo.y <= p.y && p.y <= hi.y; }
 };
+
+/// The bounding box of one segment.
+inline Box box_of(const Segment& s) {
+    Box b;
+    b.add(s);
+    return b;
+}
+
+/// Whether two closed boxes share no point (exact comparisons).
+inline bool boxes_apart(const Box& p, const Box& q) {
+    return p.hi.x < q.lo.x || q.hi.x < p.lo.x || p.hi.y < q.lo.y || q.hi.y < p.lo.y;
+}
 
 /// Whether the segment from p to q meets the closed box b (clipping the
 /// segment's parameter range to each axis' slab, Liang and Barsky 1984; an

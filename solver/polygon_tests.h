@@ -56,14 +56,10 @@ inline bool orientations_meet(const Segment& s, Vec2 a, Vec2 b) {
 // side, floors in line: each was taken to touch the other).
 inline bool meets(const Segment& s, const std::vector<Vec2>& poly) {
     const size_t n = poly.size();
-    const double lo_x = std::min(s.a.x, s.b.x), hi_x = std::max(s.a.x, s.b.x);
-    const double lo_y = std::min(s.a.y, s.b.y), hi_y = std::max(s.a.y, s.b.y);
+    const Box sb = box_of(s);
     for (size_t k = 0; k < n; ++k) {
         const Vec2 a = poly[k], b = poly[(k + 1) % n];
-        if (std::max(a.x, b.x) < lo_x || std::min(a.x, b.x) > hi_x || std::max(a.y, b.y) < lo_y ||
-            std::min(a.y, b.y) > hi_y)
-            continue;
-        if (orientations_meet(s, a, b)) return true;
+        if (!boxes_apart(sb, box_of({a, b})) && orientations_meet(s, a, b)) return true;
     }
     return false;
 }
@@ -89,14 +85,12 @@ inline bool meets_or_in_line(const Segment& s, const std::vector<Vec2>& poly) {
 // (a shelf against a wall) does not.
 inline bool crosses(const Segment& s, const std::vector<Vec2>& poly) {
     const size_t n = poly.size();
-    const double lo_x = std::min(s.a.x, s.b.x), hi_x = std::max(s.a.x, s.b.x);
-    const double lo_y = std::min(s.a.y, s.b.y), hi_y = std::max(s.a.y, s.b.y);
+    const Box sb = box_of(s);
     for (size_t k = 0; k < n; ++k) {
         const Vec2 a = poly[k], b = poly[(k + 1) % n];
         const double o3 = orient(s.a, s.b, a), o4 = orient(s.a, s.b, b);
         // The corner a on s.
-        if (std::abs(o3) <= orient_margin(s.a, s.b, a) && lo_x <= a.x && a.x <= hi_x && lo_y <= a.y && a.y <= hi_y)
-            return true;
+        if (std::abs(o3) <= orient_margin(s.a, s.b, a) && sb.holds(a)) return true;
         const double o1 = orient(a, b, s.a), o2 = orient(a, b, s.b);
         const bool ends_apart = (o1 > orient_margin(a, b, s.a) && o2 < -orient_margin(a, b, s.b)) ||
                                 (o1 < -orient_margin(a, b, s.a) && o2 > orient_margin(a, b, s.b));

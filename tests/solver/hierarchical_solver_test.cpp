@@ -278,6 +278,16 @@ void check_default_eps_against_exact(const Scene& s, int K, double patch_tol, do
     CHECK(h.totals.balance[0] <= balance_bar);
 }
 
+// A 4 x 3 room of one-sided walls (material "w", reflectance rho) with the
+// given surfaces after it, which may use "w", a lamp "l" (emission 1) and a
+// black "b".
+Scene room_of(double rho, const std::string& surfaces, const char* file) {
+    return parse_scene(fmt::format(R"({{"flatrad":1,"materials":{{"w":{{"reflectance":{}}},"l":{{"emission":1}},"b":{{"reflectance":0}}}},
+      "surfaces":[{{"name":"room","material":"w","closed":true,"side":"in","points":[[0,0],[4,0],[4,3],[0,3]]}},{}]}})",
+                                   rho, surfaces),
+                       file);
+}
+
 }  // namespace
 
 TEST_CASE("hierarchical solver: a black or one-sided plate in a closed room absorbs what reaches it") {
@@ -298,12 +308,11 @@ TEST_CASE("hierarchical solver: a black or one-sided plate in a closed room abso
                          Case{0.99, R"("material":"w","side":"left")"}}) {
         CAPTURE(c.rho);
         CAPTURE(c.plate);
-        const Scene s = parse_scene(fmt::format(R"({{"flatrad":1,"materials":{{"w":{{"reflectance":{}}},"l":{{"emission":1}},"b":{{"reflectance":0}}}},
-      "surfaces":[{{"name":"room","material":"w","closed":true,"side":"in","points":[[0,0],[4,0],[4,3],[0,3]]}},
-                  {{"name":"lamp","material":"l","side":"both","points":[[1.5,2],[2.5,2]]}},
-                  {{"name":"plate",{},"points":[[0.5,0.5],[1.5,0.5]]}}]}})",
-                                                c.rho, c.plate),
-                                    "plate.json");
+        const Scene s = room_of(c.rho,
+                                fmt::format(R"({{"name":"lamp","material":"l","side":"both","points":[[1.5,2],[2.5,2]]}},
+                  {{"name":"plate",{},"points":[[0.5,0.5],[1.5,0.5]]}})",
+                                            c.plate),
+                                "plate.json");
         // As the lamp against the wall below: about the default eps's
         // accuracy on the data scenes, with margin, against the lamp's B of
         // 1; measured at most 4.2e-3 (0.9, below the stiffness bar: rows
@@ -319,10 +328,8 @@ TEST_CASE("hierarchical solver: a lamp against the wall of a stiff room keeps th
     // row was closed to 1 and the refinement's error came back 1 / (1 -
     // rho) = 100 times: walls 0.912 for 0.863, balance 5.4e-2. With them
     // proven unseen (solver/sink_visibility.h): 0.8633, balance 8e-5.
-    const Scene s = parse_scene(R"({"flatrad":1,"materials":{"w":{"reflectance":0.99},"l":{"emission":1}},
-      "surfaces":[{"name":"room","material":"w","closed":true,"side":"in","points":[[0,0],[4,0],[4,3],[0,3]]},
-                  {"name":"lamp","material":"l","side":"both","points":[[3.5,1],[4,1]]}]})",
-                                "lamp_on_wall.json");
+    const Scene s = room_of(0.99, R"({"name":"lamp","material":"l","side":"both","points":[[3.5,1],[4,1]]})",
+                            "lamp_on_wall.json");
     // About the default eps's accuracy on the data scenes (README: 0.06-0.2%
     // relative L2) with margin, against the lamp's B of 1; measured 4e-4
     // and 8e-5 (the old code: 5.7e-2 and 5.4e-2).
@@ -338,16 +345,12 @@ TEST_CASE("hierarchical solver: sinks seen only from outside a stiff room leave 
     // 100 times: 5.6e-2 and 3.5e-2 of the lamp's B off, balance 2.8e-2 and
     // 2.6e-2. A closed loop between the rows and the sinks now leaves the
     // rows inside closed (solver/closed_rows.h).
-    const Scene through = parse_scene(R"({"flatrad":1,"materials":{"w":{"reflectance":0.99},"l":{"emission":1}},
-      "surfaces":[{"name":"room","material":"w","closed":true,"side":"in","points":[[0,0],[4,0],[4,3],[0,3]]},
-                  {"name":"lamp","material":"l","side":"both","points":[[3.5,1],[4.5,1]]}]})",
-                                      "lamp_through_wall.json");
-    const Scene two = parse_scene(R"({"flatrad":1,"materials":{"w":{"reflectance":0.99},"l":{"emission":1}},
-      "surfaces":[{"name":"room","material":"w","closed":true,"side":"in","points":[[0,0],[4,0],[4,3],[0,3]]},
-                  {"name":"room2","material":"w","closed":true,"side":"in","points":[[5,0],[8,0],[8,3],[5,3]]},
+    const Scene through = room_of(0.99, R"({"name":"lamp","material":"l","side":"both","points":[[3.5,1],[4.5,1]]})",
+                                  "lamp_through_wall.json");
+    const Scene two = room_of(0.99, R"({"name":"room2","material":"w","closed":true,"side":"in","points":[[5,0],[8,0],[8,3],[5,3]]},
                   {"name":"lamp","material":"l","side":"both","points":[[1,1],[2,1]]},
-                  {"name":"lamp2","material":"l","side":"both","points":[[6,2],[7,2.5]]}]})",
-                                  "two_rooms.json");
+                  {"name":"lamp2","material":"l","side":"both","points":[[6,2],[7,2.5]]})",
+                              "two_rooms.json");
     // As the lamp against the wall above; measured 2.6e-4 and 2.4e-4 of the
     // lamp's B, balance 5.5e-5 and 2.5e-4.
     constexpr double patch_tol = 1e-2, balance_bar = 1e-2;
