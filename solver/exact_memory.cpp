@@ -12,7 +12,10 @@ constexpr double gib = 1024.0 * 1024 * 1024;
 }  // namespace
 
 double exact_solver_memory_bytes(const Scene& scene, int K) {
-    const double n = static_cast<double>(scene.patches.size()) * static_cast<double>(K);
+    return exact_solver_memory_bytes_for(scene, static_cast<double>(scene.patches.size()) * static_cast<double>(K));
+}
+
+double exact_solver_memory_bytes_for(const Scene& scene, double n) {
     // The three dense n x n matrices: F, A = I - rho F, A's LU factors.
     const double matrices = 3 * n * n * sizeof(double);
     // Per element: its record (a segment, indices, parameters: ~64 bytes),

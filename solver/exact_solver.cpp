@@ -32,20 +32,53 @@ double seconds_since(Clock::time_point t) { return std::chrono::duration<double>
 
 }  // namespace
 
-Solution solve_exact(const Scene& scene, const ExactSolverOptions& options) {
+namespace {
+
+// Both: K equal elements per patch where `mesh` is null, else its elements.
+Solution solve(const Scene& scene, const ExactMesh* mesh, const ExactSolverOptions& options) {
     const auto t_start = Clock::now();
-    const int K = options.subdivide;
-    if (K < 1) throw InputError(scene.file, "--subdivide", fmt::format("expected an integer >= 1, found {}", K));
-    check_exact_solver_memory(scene, K);
+    const int K = mesh ? 0 : options.subdivide;
+    if (mesh) {
+        check_mesh(scene, *mesh);
+        const double bytes = exact_solver_memory_bytes_for(scene, static_cast<double>(mesh->elements()));
+        if (bytes > exact_solver_memory_limit_bytes)
+            throw InputError(scene.file, "",
+                             fmt::format("a mesh of {} elements would need {:.1f} GiB for the exact solver; the limit "
+                                         "is {:.0f} GiB",
+                                         mesh->elements(), bytes / (1024.0 * 1024 * 1024),
+                                         exact_solver_memory_limit_bytes / (1024.0 * 1024 * 1024)));
+    } else {
+        if (K < 1) throw InputError(scene.file, "--subdivide", fmt::format("expected an integer >= 1, found {}", K));
+        check_exact_solver_memory(scene, K);
+    }
     const int threads = options.threads > 0 ? options.threads : omp_get_max_threads();
     const int C = scene.channels;
 
-    // 1. Elements: K equal pieces of each patch, along its lit-left orientation.
+    // 1. Elements: K equal pieces of each patch, along its lit-left
+    //    orientation, or the mesh's.
     std::vector<Element> elems;
-    elems.reserve(scene.patches.size() * static_cast<size_t>(K));
+    elems.reserve(mesh ? static_cast<size_t>(mesh->elements()) : scene.patches.size() * static_cast<size_t>(K));
     for (size_t p = 0; p < scene.patches.size(); ++p) {
         const Patch& patch = scene.patches[p];
         const Segment o = scene.patch_segment(static_cast<int>(p));
+        if (mesh) {
+            // Cuts in file order t; along the oriented segment s = t for a
+            // left-lit patch, 1 - t for a right-lit one.
+            const std::vector<double>& cuts = mesh->cuts[p];
+            const size_t m = cuts.size() + 1;
+            for (size_t k = 0; k < m; ++k) {
+                Element e;
+                e.t0 = k == 0 ? 0.0 : cuts[k - 1];
+                e.t1 = k + 1 == m ? 1.0 : cuts[k];
+                const double s0 = patch.lit_left ? e.t0 : 1 - e.t1, s1 = patch.lit_left ? e.t1 : 1 - e.t0;
+                e.seg = {s0 == 0 ? o.a : lerp(o.a, o.b, s0), s1 == 1 ? o.b : lerp(o.a, o.b, s1)};
+                e.patch = static_cast<int>(p);
+                e.segment = patch.segment;
+                e.length = patch.length * (e.t1 - e.t0);
+                elems.push_back(e);
+            }
+            continue;
+        }
         for (int k = 0; k < K; ++k) {
             const double s0 = static_cast<double>(k) / K, s1 = static_cast<double>(k + 1) / K;
             Element e;
@@ -165,8 +198,14 @@ Solution solve_exact(const Scene& scene, const ExactSolverOptions& options) {
         pr.radiosity.assign(static_cast<size_t>(C), 0.0);
         for (int c = 0; c < C; ++c) {
             CompensatedSum s;
-            for (const ElementValue& v : pr.elements) s.add(v.B[static_cast<size_t>(c)]);
-            pr.radiosity[static_cast<size_t>(c)] = s.value() / static_cast<double>(pr.elements.size());
+            if (mesh) {
+                // Elements of different lengths: weighted by their share of the patch.
+                for (const ElementValue& v : pr.elements) s.add((v.t1 - v.t0) * v.B[static_cast<size_t>(c)]);
+                pr.radiosity[static_cast<size_t>(c)] = s.value();
+            } else {
+                for (const ElementValue& v : pr.elements) s.add(v.B[static_cast<size_t>(c)]);
+                pr.radiosity[static_cast<size_t>(c)] = s.value() / static_cast<double>(pr.elements.size());
+            }
         }
     }
     const Eigen::MatrixXd H = F * B;  // irradiance on each element
@@ -203,6 +242,14 @@ Solution solve_exact(const Scene& scene, const ExactSolverOptions& options) {
                         {"result", result_time}};
     sol.stats.time_s = seconds_since(t_start);
     return sol;
+}
+
+}  // namespace
+
+Solution solve_exact(const Scene& scene, const ExactSolverOptions& options) { return solve(scene, nullptr, options); }
+
+Solution solve_exact(const Scene& scene, const ExactMesh& mesh, const ExactSolverOptions& options) {
+    return solve(scene, &mesh, options);
 }
 
 }  // namespace flatrad

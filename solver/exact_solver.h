@@ -4,6 +4,7 @@
 /// and the dense system (I - rho F) B = E solved directly (Eigen LU) per
 /// channel. The yardstick for every approximation.
 #include "engine/scene.h"
+#include "solver/exact_mesh.h"
 #include "solver/solution.h"
 
 namespace flatrad {
@@ -26,6 +27,8 @@ constexpr double exact_solver_memory_limit_bytes = 8.0 * 1024 * 1024 * 1024;
 /// under a byte in the range that matters (below 2^53).
 /// Pre: K >= 1.
 double exact_solver_memory_bytes(const Scene& scene, int K);
+/// The same for a mesh of `elements` elements in all.
+double exact_solver_memory_bytes_for(const Scene& scene, double elements);
 
 /// Throws InputError (file: the scene's; path: "--subdivide" when K > 1,
 /// else none) when exact_solver_memory_bytes(scene, K) exceeds
@@ -39,5 +42,12 @@ void check_exact_solver_memory(const Scene& scene, int K);
 /// the surfaces involved, and, before any work, when the run would need
 /// more memory than the limit (check_exact_solver_memory).
 Solution solve_exact(const Scene& scene, const ExactSolverOptions& options = {});
+
+/// The same on `mesh`'s elements (solver/exact_mesh.h) instead of K equal
+/// ones (options.subdivide is not read): the solution's `subdivide` is 0
+/// and each patch's radiosity the length-weighted mean of its elements'.
+/// Throws std::invalid_argument for a mesh that check_mesh refuses, and
+/// InputError for one beyond the memory limit.
+Solution solve_exact(const Scene& scene, const ExactMesh& mesh, const ExactSolverOptions& options = {});
 
 }  // namespace flatrad

@@ -148,7 +148,7 @@ int run_compare(const CompareArgs& args, std::ostream& out, std::ostream& err) {
     r_options.threads = args.threads;
     if (!args.quiet)
         r_options.on_solve = [&err](long K, long elements) {
-            err << fmt::format("compare: exact solve, K = {} ({} elements)\n", K, elements) << std::flush;
+            err << fmt::format("compare: exact solve, {}\n", reference_mesh_name(K, elements)) << std::flush;
         };
     const Reference ref = solve_reference(scene, r_options, [&](const Solution& candidate) {
         return compare_solutions(scene, hier, candidate).relative_l2;
@@ -160,7 +160,7 @@ int run_compare(const CompareArgs& args, std::ostream& out, std::ostream& err) {
     const bool reached = ref.reached;
     nlohmann::ordered_json steps = nlohmann::ordered_json::array();
     for (const ReferenceStep& s : ref.steps)
-        steps.push_back({{"subdivide", s.subdivide}, {"error_estimate", number(s.error_estimate)},
+        steps.push_back({{"subdivide", s.subdivide}, {"elements", s.elements}, {"error_estimate", number(s.error_estimate)},
                          {"hierarchical_relative_l2", number(s.compared_error)}});
 
     // 3. Report.
@@ -181,8 +181,10 @@ int run_compare(const CompareArgs& args, std::ostream& out, std::ostream& err) {
     x["time_total_s"] = ref.time_total_s;
     j["exact"] = x;
     j["reference"] = {{"subdivide", reference_K},
+                      {"mesh", ref.mesh_name()},
                       {"error_estimate", number(estimate)},
                       {"estimate_from_subdivide", ref.estimate_from_subdivide},
+                      {"estimate_from", ref.estimate_from},
                       {"target", number(h_err.relative_l2 / reference_margin)},
                       {"reached", reached},
                       {"stopped", ref.stopped},
@@ -197,7 +199,7 @@ int run_compare(const CompareArgs& args, std::ostream& out, std::ostream& err) {
         err << fmt::format("compare: {} ({} patches, {} channel{})\n", scene.name, patches, scene.channels,
                            scene.channels == 1 ? "" : "s");
         err << fmt::format("  {:<22}{:>18}{:>22}\n", "", fmt::format("hierarchical"),
-                           fmt::format("exact K={}", reference_K));
+                           reference_K > 0 ? fmt::format("exact K={}", reference_K) : std::string("exact, graded"));
         err << fmt::format("  {:<22}{:>18}{:>22}\n", "settings",
                            fmt::format("eps {:g}", hier.eps), fmt::format("vis_eps {:g}", hier.vis_eps));
         err << fmt::format("  {:<22}{:>18}{:>22}\n", "relative L2 error", sci(h_err.relative_l2),
@@ -237,8 +239,8 @@ int run_compare(const CompareArgs& args, std::ostream& out, std::ostream& err) {
         err << fmt::format("  {:<22}{:>18}{:>22}\n", "elements", hier.stats.elements, reference.stats.elements);
         err << fmt::format("  {:<22}{:>18}{:>22}\n", "links", hier.stats.links, reference.stats.links);
         if (reached)
-            err << fmt::format("  reference: K = {}, its own error estimate {} <= 1/10 of the hierarchical error\n",
-                               reference_K, sci(estimate));
+            err << fmt::format("  reference: {}, its own error estimate {} <= 1/10 of the hierarchical error\n",
+                               ref.mesh_name(), sci(estimate));
         else
             err << fmt::format("  reference NOT good enough: estimate {} > 1/10 of the hierarchical error {}; "
                                "stopped: {}\n",

@@ -6,22 +6,38 @@
 ///
 /// The reference must be much better than what it judges, so the exact
 /// solver's own discretisation error is estimated and driven down:
-///   1. solve exactly at K (ReferenceOptions::subdivide) and at 2K; the
-///      estimate of the K solution's error is the relative L2 distance
-///      between the two (cli/solution_error.h), and the compared error is
-///      measured against the 2K solution;
-///   2. while the estimate exceeds 1/reference_margin of the compared error,
-///      double K (the old 2K solve is reused) and go to 1 -- unless the
-///      next 2K would exceed the exact solver's memory limit
-///      (exact_solver_memory_bytes) or max_elements, or the estimate is at
-///      rounding level (reference_rounding_floor: K and 2K agree, a finer
-///      mesh cannot do better); then the last solve is the reference with
-///      `reached` false and `stopped` saying why.
-/// The estimate is that of the K solution; the 2K reference used is
-/// usually better still (its error shrinks with K), so the estimate is
-/// conservative. The compared error is a function of the candidate, so a
-/// caller judging several solutions passes the smallest of their errors:
-/// the reference is then good enough for every one of them.
+///   1. solve exactly on a mesh M and on M halved (every element cut at its
+///      midpoint); the estimate of the M solution's error is the relative
+///      L2 distance between the two (cli/solution_error.h), and the
+///      compared error is measured against the halved solution;
+///   2. first M is K equal elements per patch (ReferenceOptions::subdivide;
+///      halved while the pair would not fit, so that the reference always
+///      comes with an estimate if one fits at all) and M halved is 2K;
+///      while the estimate exceeds 1/reference_margin of the compared
+///      error, K doubles (the old 2K solve is reused);
+///   3. when the next doubling would not fit, the mesh is graded instead:
+///      each element of the last pair's M gets an indicator, the squared
+///      length-weighted difference between its value and its halves' in
+///      the finer solve (where the radiosity varies within it, or the
+///      finer mesh moved it), and the elements above a threshold are cut
+///      in 2, 4, ... 2^max_graded_level pieces by how far above it they
+///      are (the error of constant elements falls as h^1.5 in this norm).
+///      The threshold shares the target error equally over the elements,
+///      raised until the new pair fits and M grows by at most
+///      graded_growth; then 1 on the new M. A slit under a table leg or
+///      the gap between two books gets its elements without every wall
+///      getting them too;
+///   4. it stops when the estimate is reached, when no new pair fits
+///      (exact_solver_memory_bytes, max_elements) or no element is left
+///      to cut, or when the estimate is at rounding level
+///      (reference_rounding_floor: a finer mesh cannot do better); then
+///      the last solve is the reference with `reached` false and `stopped`
+///      saying why.
+/// The estimate is that of the pair's coarser solve; the halved reference
+/// used is usually better still (its error shrinks with the elements), so
+/// the estimate is conservative. The compared error is a function of the
+/// candidate, so a caller judging several solutions passes the smallest of
+/// their errors: the reference is then good enough for every one of them.
 #include <functional>
 #include <limits>
 #include <string>
@@ -48,12 +64,22 @@ inline constexpr double reference_rounding_floor = 1e-12;
 /// solver's own memory limit (8 GiB) would allow ~19000, hours of work.
 inline constexpr long default_reference_max_elements = 8000;
 
+/// A graded step's M grows by at most this factor: the indicators come
+/// from the last pair, and a smaller step lets the next pair's correct
+/// them (the furnished room from K = 8: 2.9e-4 after one step of 1.36x,
+/// 1.5e-4 and 1.2e-4 after two more; 14 steps of a few elements each
+/// reached 1.2e-4 only after eleven).
+inline constexpr double graded_growth = 1.5;
+
+/// The most a graded step cuts one element: into 2^6 = 64 pieces.
+inline constexpr int max_graded_level = 6;
+
 struct ReferenceOptions {
     int subdivide = 16;                                   ///< first K, >= 1
     long max_elements = default_reference_max_elements;   ///< largest mesh (patches x K) tried, >= 1
     int threads = 0;                                      ///< 0: all cores
-    /// Called before each exact solve with its K and its elements
-    /// (patches x K), e.g. to log it; may be empty.
+    /// Called before each exact solve with its K (0 for a graded mesh)
+    /// and its elements, e.g. to log it; may be empty.
     std::function<void(long K, long elements)> on_solve;
 };
 
@@ -61,19 +87,23 @@ struct ReferenceOptions {
 /// the exact solver's memory limit.
 bool reference_fits(const Scene& scene, long K, long max_elements);
 
-/// One K -> 2K doubling of step 1.
+/// One pair of step 1: M against M halved.
 struct ReferenceStep {
-    long subdivide = 0;          ///< K
-    double error_estimate = 0;   ///< relative L2 of the K solution against the 2K one
-    double compared_error = 0;   ///< the compared error against the 2K solution
+    long subdivide = 0;          ///< K of M; 0 when M is graded
+    long elements = 0;           ///< M's elements
+    double error_estimate = 0;   ///< relative L2 of the M solution against the halved one
+    double compared_error = 0;   ///< the compared error against the halved solution
 };
+
+/// "K = 16 (5680 elements)", or "graded (3977 elements)" for K = 0.
+std::string reference_mesh_name(long K, long elements);
 
 struct Reference {
     /// Every exact solve, coarse to fine (K, 2K, 4K, ...); the last one is
     /// the reference. Kept so that callers can draw the exact solver's own
     /// error against its run time.
     std::vector<Solution> ladder;
-    std::vector<long> ladder_subdivide;  ///< K of each ladder entry
+    std::vector<long> ladder_subdivide;  ///< K of each ladder entry; 0 for a graded mesh
     /// Relative L2 (and max relative) of the last pair's coarser solve
     /// against its finer; +inf (NaN) when no pair was solved.
     double error_estimate = std::numeric_limits<double>::infinity();
@@ -83,14 +113,19 @@ struct Reference {
     PatchRelative estimate_patch_relative{std::numeric_limits<double>::quiet_NaN(),
                                           std::numeric_limits<double>::quiet_NaN(),
                                           std::numeric_limits<double>::quiet_NaN()};
-    long estimate_from_subdivide = 0;  ///< K of that coarser solve; 0 when none
+    long estimate_from_subdivide = 0;  ///< K of that coarser solve; 0 when none or graded
+    /// That coarser solve's mesh as reference_mesh_name writes it, and its
+    /// halved one ("K = 8 (2840 elements) against K = 16 (5680 elements)");
+    /// empty when no pair was solved.
+    std::string estimate_from;
     bool reached = false;              ///< error_estimate <= compared error / reference_margin
     std::string stopped;               ///< why the doubling stopped short; empty when reached
     std::vector<ReferenceStep> steps;
     double time_total_s = 0;           ///< all exact solves together
 
     const Solution& solution() const { return ladder.back(); }
-    long subdivide() const { return ladder_subdivide.back(); }
+    long subdivide() const { return ladder_subdivide.back(); }  ///< 0 when graded
+    std::string mesh_name() const { return reference_mesh_name(subdivide(), solution().stats.elements); }
 };
 
 /// Builds the reference for `scene` as above. `compared_error(candidate)`

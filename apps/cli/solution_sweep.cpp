@@ -55,9 +55,9 @@ std::vector<std::string> split(const std::string& s, char sep) {
     }
 }
 
-// "K = 64 (2368 elements)" for the reference and the ladder.
-std::string mesh(long K, const Scene& scene) {
-    return fmt::format("K = {} ({} elements)", K, K * static_cast<long>(scene.patches.size()));
+// "K=64" or "graded 3977": a plot's point label.
+std::string short_mesh(long K, const Solution& s) {
+    return K > 0 ? fmt::format("K={}", K) : fmt::format("graded {}", s.stats.elements);
 }
 
 std::string scene_label(const Scene& scene) {
@@ -192,9 +192,7 @@ std::string solution_sweep_csv(const SolutionSweep& s, const Scene& scene) {
         "error_estimate {} ({}), target {} (1/{} of the smallest relative_l2 {}), reached {}{}",
         scene.name, scene.file, scene.patches.size(), scene.channels, s.repeat, r.subdivide(), ref.stats.elements,
         ref.stats.time_s, r.time_total_s, r.error_estimate,
-        r.estimate_from_subdivide > 0
-            ? fmt::format("K = {} against K = {}", r.estimate_from_subdivide, 2 * r.estimate_from_subdivide)
-            : "no K and 2K pair was solved",
+        !r.estimate_from.empty() ? r.estimate_from : "no pair of a mesh and its halves was solved",
         s.smallest_error / reference_margin, reference_margin, s.smallest_error, r.reached ? "true" : "false",
         r.stopped.empty() ? "" : ", stopped: " + r.stopped));
     csv += '\n';
@@ -224,7 +222,7 @@ SvgPlot solution_error_time_plot(const SolutionSweep& s, const Scene& scene) {
         if (!(row.error.relative_l2 > 0)) ++zero;
     p.subtitle = fmt::format(
         "errors against exact {} (its own error {} estimated, {}); hierarchical time: median of {} run{}{}",
-        mesh(r.subdivide(), scene), sci(r.error_estimate), r.reached ? "10x below every row" : "NOT 10x below every row",
+        r.mesh_name(), sci(r.error_estimate), r.reached ? "10x below every row" : "NOT 10x below every row",
         s.repeat, s.repeat == 1 ? "" : "s",
         zero ? fmt::format("; {} row{} with error 0 not shown (log axis)", zero, zero == 1 ? "" : "s") : "");
     p.x.label = "run time (s, log)";
@@ -244,12 +242,12 @@ SvgPlot solution_error_time_plot(const SolutionSweep& s, const Scene& scene) {
     for (size_t k = 0; k + 1 < r.ladder.size(); ++k) {
         ladder.x.push_back(r.ladder[k].stats.time_s);
         ladder.y.push_back(s.ladder_error[k].relative_l2);
-        ladder.point_labels.push_back(fmt::format("K={}", r.ladder_subdivide[k]));
+        ladder.point_labels.push_back(short_mesh(r.ladder_subdivide[k], r.ladder[k]));
     }
     PlotSeries reference{"reference, its estimated error", {}, {}, PlotMark::Points, red};
     reference.x.push_back(r.solution().stats.time_s);
     reference.y.push_back(r.error_estimate);
-    reference.point_labels.push_back(fmt::format("K={}", r.subdivide()));
+    reference.point_labels.push_back(short_mesh(r.subdivide(), r.solution()));
     p.series = {hier};
     if (!ladder.x.empty()) p.series.push_back(ladder);
     p.series.push_back(reference);
@@ -267,7 +265,7 @@ SvgPlot solution_error_eps_plot(const SolutionSweep& s, const Scene& scene) {
     SvgPlot p;
     p.title = fmt::format("{}: hierarchical error against eps", one_line(scene.name));
     p.subtitle = fmt::format("against exact {}; values of 0 (an exact balance) are not shown (log axis)",
-                             mesh(r.subdivide(), scene));
+                             r.mesh_name());
     p.x.label = "eps (relative refinement tolerance, log)";
     p.x.scale = AxisScale::Log;
     p.y.label = "error (log)";
@@ -376,7 +374,7 @@ int run_solution_sweep_command(const SweepArgs& args, std::ostream& out, std::os
                                sci(row.error.max_relative), sci(row.error.patch_relative.median), sci(row.balance),
                                row.elements, row.links, row.iterations);
         for (size_t k = 0; k < r.ladder.size(); ++k)
-            err << fmt::format("  exact {}: {:.3g} s, relative L2 {}{}\n", mesh(r.ladder_subdivide[k], scene),
+            err << fmt::format("  exact {}: {:.3g} s, relative L2 {}{}\n", reference_mesh_name(r.ladder_subdivide[k], r.ladder[k].stats.elements),
                                r.ladder[k].stats.time_s,
                                k + 1 < r.ladder.size() ? sci(sweep.ladder_error[k].relative_l2)
                                                        : "<= " + sci(r.error_estimate) + " (est.)",
@@ -384,7 +382,7 @@ int run_solution_sweep_command(const SweepArgs& args, std::ostream& out, std::os
         if (r.reached)
             err << fmt::format("  reference: {}, its own error estimate {} <= 1/10 of the smallest hierarchical "
                                "error {}\n",
-                               mesh(r.subdivide(), scene), sci(r.error_estimate), sci(sweep.smallest_error));
+                               r.mesh_name(), sci(r.error_estimate), sci(sweep.smallest_error));
         else
             err << fmt::format("  reference NOT good enough for every row: estimate {} > 1/10 of the smallest "
                                "hierarchical error {}; stopped: {}\n",
