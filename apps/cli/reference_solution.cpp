@@ -176,11 +176,17 @@ Reference solve_reference(const Scene& scene, const ReferenceOptions& options,
     // 1-2. Uniform: K and 2K, doubling K. The first K is halved while its
     // pair would not fit (a reference with an estimate of its own error
     // beats a finer one without); when no pair fits at all, K alone.
+    // After the first pair, K doubles only while its pair fits in half the
+    // cap: the rest is left to grading, which spends it where it is needed
+    // (furnished_room capped at 12 000: K = 16 against 32, then graded
+    // steps of a few hundred elements, each a solve of 11 900, instead of
+    // graded meshes grown from K = 8 by half at a time).
     long K = options.subdivide;
     while (K > 1 && !reference_fits(scene, 2 * K, options.max_elements)) K /= 2;
     exact(K);
     while (true) {
-        if (!reference_fits(scene, 2 * K, options.max_elements)) {
+        const bool first = ref.ladder.size() == 1;
+        if (!reference_fits(scene, 2 * K, first ? options.max_elements : options.max_elements / 2)) {
             ref.stopped = fmt::format("K = {} ({} elements) would pass {}", 2 * K, patches * 2 * K,
                                       patches * 2 * K > options.max_elements ? "--max-elements"
                                                                               : "the exact solver's memory limit");
@@ -199,6 +205,9 @@ Reference solve_reference(const Scene& scene, const ReferenceOptions& options,
         const long n = coarse.stats.elements;
         long room = std::min(options.max_elements / 2 - n, static_cast<long>((graded_growth - 1) * static_cast<double>(n)));
         while (room > 0 && !elements_fit(scene, 2 * (n + room), options.max_elements)) room /= 2;
+        // A step that may add only a few elements costs a whole pair of
+        // solves for little: not below a twentieth of the mesh.
+        if (room < std::max(1L, n / graded_min_step)) room = 0;
         const double target = ref.steps.back().compared_error / reference_margin;
         const ExactMesh mesh = graded_step(scene, coarse, fine, target * target * squared_norm(scene, fine), room);
         if (mesh.elements() == n) {

@@ -14,7 +14,8 @@
 ///      halved while the pair would not fit, so that the reference always
 ///      comes with an estimate if one fits at all) and M halved is 2K;
 ///      while the estimate exceeds 1/reference_margin of the compared
-///      error, K doubles (the old 2K solve is reused);
+///      error, K doubles (the old 2K solve is reused) as long as the new
+///      pair fits in half the cap, the rest being left to grading;
 ///   3. when the next doubling would not fit, the mesh is graded instead:
 ///      each element of the last pair's M gets an indicator, the squared
 ///      length-weighted difference between its value and its halves' in
@@ -24,7 +25,8 @@
 ///      are (the error of constant elements falls as h^1.5 in this norm).
 ///      The threshold shares the target error equally over the elements,
 ///      raised until the new pair fits and M grows by at most
-///      graded_growth; then 1 on the new M. A slit under a table leg or
+///      graded_growth (and by at least 1/graded_min_step, or the cap has
+///      stopped it); then 1 on the new M. A slit under a table leg or
 ///      the gap between two books gets its elements without every wall
 ///      getting them too;
 ///   4. it stops when the estimate is reached, when no new pair fits
@@ -70,6 +72,10 @@ inline constexpr long default_reference_max_elements = 8000;
 /// 1.5e-4 and 1.2e-4 after two more; 14 steps of a few elements each
 /// reached 1.2e-4 only after eleven).
 inline constexpr double graded_growth = 1.5;
+
+/// A graded step adds at least 1/graded_min_step of its mesh's elements,
+/// or none is taken (the cap has stopped the search).
+inline constexpr long graded_min_step = 20;
 
 /// The most a graded step cuts one element: into 2^6 = 64 pieces.
 inline constexpr int max_graded_level = 6;

@@ -162,7 +162,7 @@ SolutionSweep run_solution_sweep(const Scene& scene, const SolutionSweepOptions&
     ReferenceOptions reference = options.reference;
     if (log || progress)
         reference.on_solve = [&](long K, long elements) {
-            say(fmt::format("sweep: exact solve, K = {} ({} elements)", K, elements));
+            say(fmt::format("sweep: exact solve, {}", reference_mesh_name(K, elements)));
             if (options.reference.on_solve) options.reference.on_solve(K, elements);
         };
     sweep.reference = solve_reference(scene, reference, [&](const Solution& candidate) {

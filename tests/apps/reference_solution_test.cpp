@@ -75,8 +75,18 @@ TEST_CASE("solve_reference: the element cap stops the doubling, and says so") {
         flatrad::solve_reference(scene, small(4, 8 * 16), [](const flatrad::Solution&) { return 0.0; });
     CHECK_FALSE(r.reached);
     CHECK(r.stopped.find("--max-elements") != std::string::npos);
-    CHECK(r.subdivide() == 16);  // 4, 8, 16; 32 would pass 128 elements
-    CHECK(r.estimate_from_subdivide == 8);
+    // K = 4 against 8 (32 and 64 elements); 8 against 16 would pass half
+    // the cap (128 > 64), so graded meshes follow, each within 64 and its
+    // halves within 128.
+    REQUIRE(r.ladder.size() >= 4);
+    CHECK(r.ladder_subdivide[0] == 4);
+    CHECK(r.ladder_subdivide[1] == 8);
+    for (size_t k = 2; k < r.ladder.size(); ++k) {
+        CHECK(r.ladder_subdivide[k] == 0);
+        CHECK(r.ladder[k].stats.elements <= (k % 2 ? 128 : 64));
+    }
+    CHECK(r.subdivide() == 0);
+    CHECK(r.estimate_from_subdivide == 0);  // a graded pair
     CHECK(std::isfinite(r.error_estimate));
 
     // No pair at K = 16 (256 elements would pass 128): K is halved until
