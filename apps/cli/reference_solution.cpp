@@ -93,6 +93,21 @@ ExactMesh graded_step(const Scene& scene, const Solution& coarse, const Solution
     double tau2 = target2 / static_cast<double>(eta.size());
     if (!(tau2 > 0)) tau2 = largest * 1e-30;
     while (levels(tau2) > room) tau2 *= 2;
+    if (std::all_of(level.begin(), level.end(), [](int l) { return l == 0; })) {
+        // The last doubling passed from too many cuts to none (indicators
+        // within a factor 2 of each other): the previous threshold's cuts,
+        // largest indicators first, while they fit.
+        levels(tau2 / 2);
+        std::vector<size_t> order(eta.size());
+        for (size_t e = 0; e < order.size(); ++e) order[e] = e;
+        std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return eta[a] > eta[b]; });
+        long added = 0;
+        for (size_t e : order) {
+            const long more = level[e] > 0 ? (1L << level[e]) - 1 : 0;
+            if (added + more > room) level[e] = 0;
+            else added += more;
+        }
+    }
     for (int r = 0; r < max_graded_level; ++r) {
         std::vector<char> marked(level.size());
         std::vector<int> next;
@@ -182,11 +197,10 @@ Reference solve_reference(const Scene& scene, const ReferenceOptions& options,
     // steps of a few hundred elements, each a solve of 11 900, instead of
     // graded meshes grown from K = 8 by half at a time).
     long K = options.subdivide;
-    while (K > 1 && !reference_fits(scene, 2 * K, options.max_elements)) K /= 2;
+    while (K > 1 && !reference_fits(scene, 2 * K, options.max_elements / 2)) K /= 2;
     exact(K);
     while (true) {
-        const bool first = ref.ladder.size() == 1;
-        if (!reference_fits(scene, 2 * K, first ? options.max_elements : options.max_elements / 2)) {
+        if (!reference_fits(scene, 2 * K, options.max_elements / 2)) {
             ref.stopped = fmt::format("K = {} ({} elements) would pass {}", 2 * K, patches * 2 * K,
                                       patches * 2 * K > options.max_elements ? "--max-elements"
                                                                               : "the exact solver's memory limit");
@@ -211,9 +225,11 @@ Reference solve_reference(const Scene& scene, const ReferenceOptions& options,
         const double target = ref.steps.back().compared_error / reference_margin;
         const ExactMesh mesh = graded_step(scene, coarse, fine, target * target * squared_norm(scene, fine), room);
         if (mesh.elements() == n) {
+            const long least = std::max(1L, n / graded_min_step);
             ref.stopped = room > 0 ? "no element left to cut"
-                                   : fmt::format("a graded mesh beyond {} elements would pass {}", n,
-                                                 2 * (n + 1) > options.max_elements
+                                   : fmt::format("a graded step from {} elements by at least {} would pass {}", n,
+                                                 least,
+                                                 2 * (n + least) > options.max_elements
                                                      ? "--max-elements (its halved pair)"
                                                      : "the exact solver's memory limit (its halved pair)");
             return ref;

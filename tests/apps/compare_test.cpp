@@ -125,10 +125,10 @@ TEST_CASE("compare: -o writes the file; bad flags give status 2") {
 
 TEST_CASE("compare: the mesh limit stops the doubling and says so") {
     const std::string scene = write_scene(pillar_box);
-    // 8 patches: K = 4 (32 elements) fits alone but not its pair (64 > 40),
-    // so it is halved to K = 2 (16 elements, its pair 32), then graded
-    // meshes of at most 20 elements (their halved pairs within 40): not
-    // enough for eps 1e-3.
+    // 8 patches: K = 4 (32 elements) fits alone, but a first pair must fit
+    // in half the cap (20), so K is halved to 1 (8 elements, its pair 16),
+    // then graded meshes of at most 20 elements (their halved pairs within
+    // 40): not enough for eps 1e-3.
     const Run r = run({"compare", scene, "-q", "--eps", "1e-3", "--subdivide", "4", "--max-elements", "40"});
     REQUIRE(r.status == 0);
     const json j = json::parse(r.out);
@@ -136,7 +136,7 @@ TEST_CASE("compare: the mesh limit stops the doubling and says so") {
     CHECK(j["reference"]["stopped"].get<std::string>().find("--max-elements") != std::string::npos);
     CHECK(j["exact"]["elements"].get<long>() <= 40);
     REQUIRE(j["reference"]["steps"].size() >= 1);
-    CHECK(j["reference"]["steps"][0]["subdivide"].get<long>() == 2);
+    CHECK(j["reference"]["steps"][0]["subdivide"].get<long>() == 1);
     CHECK(finite_number(j["reference"]["error_estimate"]));
     CHECK(finite_number(j["hierarchical"]["error"]["relative_l2"]));
     fs::remove(scene);

@@ -89,14 +89,15 @@ TEST_CASE("solve_reference: the element cap stops the doubling, and says so") {
     CHECK(r.estimate_from_subdivide == 0);  // a graded pair
     CHECK(std::isfinite(r.error_estimate));
 
-    // No pair at K = 16 (256 elements would pass 128): K is halved until
-    // one fits, so that the reference comes with an estimate.
+    // No pair at K = 16 within half the cap (256 elements > 64): K is
+    // halved until one fits, so that the reference comes with an estimate
+    // and room is left to grade.
     const flatrad::Reference halved =
         flatrad::solve_reference(scene, small(16, 8 * 16), [](const flatrad::Solution&) { return 1.0; });
     REQUIRE(halved.ladder.size() >= 2);
-    CHECK(halved.ladder_subdivide[0] == 8);
-    CHECK(halved.ladder_subdivide[1] == 16);
-    CHECK(halved.estimate_from_subdivide == 8);
+    CHECK(halved.ladder_subdivide[0] == 4);
+    CHECK(halved.ladder_subdivide[1] == 8);
+    CHECK(halved.estimate_from_subdivide == 4);
     CHECK(std::isfinite(halved.error_estimate));
 
     // No pair at all (K = 1 is 8 elements, its pair 16): K alone, its error unknown.
@@ -167,14 +168,14 @@ TEST_CASE("solve_reference: a graded mesh puts its elements where a uniform one 
     fine.subdivide = 256;
     const flatrad::Solution truth = flatrad::solve_exact(scene, fine);
 
-    // A cap of 128 elements: the uniform pairs stop at K = 4 against 8
-    // (80 elements; K = 16 would pass it), then graded pairs of up to 64.
+    // A cap of 128 elements: the first pair must fit in half of it, so K = 4
+    // is halved to 2 (20 against 40 elements), then graded pairs of up to 64.
     constexpr long cap = 128;
     const flatrad::Reference r =
         flatrad::solve_reference(scene, small(4, cap), [](const flatrad::Solution&) { return 0.0; });
     REQUIRE(r.ladder.size() >= 4);
-    CHECK(r.ladder_subdivide[0] == 4);
-    CHECK(r.ladder_subdivide[1] == 8);
+    CHECK(r.ladder_subdivide[0] == 2);
+    CHECK(r.ladder_subdivide[1] == 4);
     CHECK(r.ladder_subdivide.back() == 0);  // the reference is graded
     CHECK(r.subdivide() == 0);
     CHECK(r.mesh_name().rfind("graded (", 0) == 0);
@@ -189,15 +190,16 @@ TEST_CASE("solve_reference: a graded mesh puts its elements where a uniform one 
     CHECK_FALSE(r.reached);  // a judged error of 0 is never reached
     CHECK(r.stopped.find("--max-elements") != std::string::npos);
 
-    // The uniform reference of this cap, K = 8 (its estimate from K = 4),
-    // against the graded one at no more elements.
-    const flatrad::Solution& uniform = r.ladder[1];
+    // Against the finest uniform mesh within the cap, K = 12 (120 elements).
+    flatrad::ExactSolverOptions twelve;
+    twelve.subdivide = 12;
+    const flatrad::Solution uniform = flatrad::solve_exact(scene, twelve);
     const double uniform_error = distance(scene, uniform, truth), graded_error = distance(scene, r.solution(), truth);
-    MESSAGE("uniform K = 8 (", uniform.stats.elements, " elements): ", uniform_error, "; graded (",
+    MESSAGE("uniform K = 12 (", uniform.stats.elements, " elements): ", uniform_error, "; graded (",
             r.solution().stats.elements, "): ", graded_error, ", estimated <= ", r.error_estimate);
     CHECK(r.solution().stats.elements <= cap);
-    // Grading must pay, by a digit at least (measured: 3.9e-4 against
-    // 2.1e-2, 53x, with 128 elements against 80).
+    // Grading must pay, by a digit at least (measured: 2.1e-4 against
+    // 6.4e-3, 30x, with 128 elements against 120).
     CHECK(graded_error < 0.1 * uniform_error);
     // And its estimate (of the pair's coarser solve) must hold for the
     // reference itself, the finer one.
