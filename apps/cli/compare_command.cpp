@@ -79,10 +79,13 @@ std::string sci(double v) { return std::isfinite(v) ? fmt::format("{:.3e}", v) :
 CLI::App* add_compare_command(CLI::App& app, CompareArgs& a) {
     CLI::App* cmd = app.add_subcommand("compare", "Hierarchical against exact: error and run time, side by side.");
     cmd->footer(
-        "Solves the scene hierarchically, then exactly at K and 2K elements per patch (K from --subdivide), "
-        "doubling K until the exact solution's own error (estimated as the relative L2 distance between K "
-        "and 2K) is at most 1/10 of the hierarchical error against the 2K solution, or until the next mesh "
-        "would pass --max-elements or the exact solver's memory limit (then \"reached\": false). Errors are "
+        "Solves the scene hierarchically, then exactly on a mesh and on its halves (every element cut in two): "
+        "first K and 2K elements per patch (K from --subdivide, halved until the pair fits in half of "
+        "--max-elements), doubling K while the pair fits in half of it, then graded meshes, each element cut "
+        "where it and its halves disagree most, until the exact solution's own error (estimated as the "
+        "relative L2 distance between the mesh and its halves) is at most 1/10 of the hierarchical error "
+        "against the finer solution, or until the next step would pass --max-elements or the exact solver's "
+        "memory limit (then \"reached\": false). Errors are "
         "over patch radiosities, length-weighted, all channels: relative_l2, and max_relative (largest "
         "|difference| over the reference's length-weighted RMS), both at the scale of the scene's light; "
         "and patch_relative: each patch's |difference| over its own reference value, its length-weighted "
@@ -102,7 +105,7 @@ CLI::App* add_compare_command(CLI::App& app, CompareArgs& a) {
         ->type_name("K")
         ->capture_default_str();
     cmd->add_option("--max-elements", a.max_elements,
-                    "Largest exact mesh tried (patches x K), >= 1; the exact solver's memory limit applies too.")
+                    "Largest exact mesh tried (elements), >= 1; the exact solver's memory limit applies too.")
         ->type_name("N")
         ->capture_default_str();
     cmd->add_option("--threads", a.threads, "Threads; 0: all cores.")->type_name("N")->capture_default_str();

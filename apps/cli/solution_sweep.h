@@ -84,11 +84,12 @@ SolutionSweep run_solution_sweep(const Scene& scene, const SolutionSweepOptions&
                                  ProgressLine* progress = nullptr);
 
 /// The CSV table: comment lines ("# ..."): the scene, repeat and the
-/// reference (K, elements, time, error estimate, target, reached, why it
-/// stopped), then one per exact ladder solve; the header
+/// reference (K, 0 for a graded mesh; elements, time, error estimate,
+/// target, reached, why it stopped), then one per exact ladder solve; the
+/// header
 /// eps,vis_eps,time_s,relative_l2,max_relative,balance,elements,links,iterations,reference_subdivide,reference_time_s,
-/// patch_relative_median,patch_relative_p90 (cli/solution_error.h: each patch's error at its own scale)
-/// and one row per eps, doubles with round-trip precision.
+/// patch_relative_median,patch_relative_p90 (cli/solution_error.h: each patch's error at its own scale;
+/// reference_subdivide 0: a graded reference) and one row per eps, doubles with round-trip precision.
 std::string solution_sweep_csv(const SolutionSweep& sweep, const Scene& scene);
 
 /// Relative L2 error (log) against run time (log): the hierarchical rows

@@ -1,5 +1,6 @@
-// Tests apps/cli/reference_solution.h: the exact reference, K doubled until
-// its own error estimate is a tenth of the error it judges.
+// Tests apps/cli/reference_solution.h: the exact reference, K doubled and
+// then the mesh graded until its own error estimate is a tenth of the
+// error it judges.
 #include "cli/reference_solution.h"
 
 #include <cmath>
