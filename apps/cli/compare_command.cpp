@@ -13,6 +13,7 @@
 
 #include "cli/atomic_write.h"
 #include "cli/progress.h"
+#include "cli/result_json.h"
 #include "cli/scene_warnings.h"
 #include "cli/usage_error.h"
 #include "engine/error.h"
@@ -104,6 +105,10 @@ CLI::App* add_compare_command(CLI::App& app, CompareArgs& a) {
     cmd->add_option("--subdivide", a.subdivide, "K >= 1: the first reference mesh, elements per patch.")
         ->type_name("K")
         ->capture_default_str();
+    cmd->add_option("--reference-output", a.reference_output,
+                    "Also write the exact reference's result file (SPEC.md \"Result file\"; settings.subdivide 0 "
+                    "for a graded mesh), atomically.")
+        ->type_name("REF.json");
     cmd->add_option("--max-elements", a.max_elements,
                     "Largest exact mesh tried (elements), >= 1; the exact solver's memory limit applies too.")
         ->type_name("N")
@@ -125,6 +130,9 @@ int run_compare(const CompareArgs& args, std::ostream& out, std::ostream& err) {
     if (args.threads < 0)
         throw UsageError(fmt::format("--threads: expected an integer >= 0, got {}", args.threads));
     if (!args.output.empty()) check_output_path(args.output, "-o");
+    if (!args.reference_output.empty()) check_output_path(args.reference_output, "--reference-output");
+    if (!args.output.empty() && args.output == args.reference_output)
+        throw UsageError(fmt::format("-o and --reference-output name the same file: {}", args.output));
 
     const Scene scene = load_scene_reporting(args.scene, err);
     const long patches = static_cast<long>(scene.patches.size());
@@ -193,6 +201,9 @@ int run_compare(const CompareArgs& args, std::ostream& out, std::ostream& err) {
                       {"stopped", ref.stopped},
                       {"steps", steps}};
     const std::string text = j.dump(2) + "\n";
+    // The reference's own result file first: if it cannot be written, no
+    // comparison claims to have one.
+    if (!args.reference_output.empty()) write_file_atomically(args.reference_output, result_text(scene, reference));
     if (args.output.empty())
         out << text << std::flush;
     else
@@ -249,6 +260,7 @@ int run_compare(const CompareArgs& args, std::ostream& out, std::ostream& err) {
                                "stopped: {}\n",
                                sci(estimate), sci(h_err.relative_l2), ref.stopped);
         if (!args.output.empty()) err << "  written to " << args.output << '\n';
+        if (!args.reference_output.empty()) err << "  the reference written to " << args.reference_output << '\n';
         err << std::flush;
     }
     return 0;

@@ -29,10 +29,11 @@ inline constexpr long default_compare_max_elements = default_reference_max_eleme
 struct CompareArgs {
     std::string scene;        ///< scene file
     std::string output;       ///< JSON file; empty: stdout
+    std::string reference_output;  ///< the reference's result file (SPEC.md "Result file"); empty: none
     double eps = HierarchicalOptions{}.eps;  ///< hierarchical refinement tolerance, > 0 (solve's default)
     double vis_eps = -1;      ///< hierarchical visibility tolerance; < 0: eps / 10
     int subdivide = 16;       ///< first reference K, >= 1
-    long max_elements = default_compare_max_elements; ///< largest exact mesh (patches x K) tried
+    long max_elements = default_compare_max_elements; ///< largest exact mesh (elements) tried
     int threads = 0;          ///< 0: all cores
     bool quiet = false;       ///< no table on stderr
 };

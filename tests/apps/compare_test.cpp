@@ -123,6 +123,41 @@ TEST_CASE("compare: -o writes the file; bad flags give status 2") {
     fs::remove(scene);
 }
 
+TEST_CASE("compare: --reference-output writes the reference's result file, the one the errors are against") {
+    const std::string scene = write_scene(pillar_box);
+    const std::string stem = (fs::temp_directory_path() / ("flatrad_compare_ref_" + std::to_string(::getpid()))).string();
+    const std::string ref_path = stem + "_ref.json", out_path = stem + "_out.json";
+    const Run r = run({"compare", scene, "-q", "--eps", "0.05", "--subdivide", "4", "--max-elements", "200",
+                       "--reference-output", ref_path, "-o", out_path});
+    REQUIRE(r.status == 0);
+    std::ifstream ref_in(ref_path), out_in(out_path);
+    const json ref = json::parse(ref_in), cmp = json::parse(out_in);
+    CHECK(ref["method"] == "exact");
+    CHECK(ref["settings"]["subdivide"].get<long>() == cmp["reference"]["subdivide"].get<long>());
+    REQUIRE(ref["patches"].size() == 8);
+    long elements = 0;
+    for (const auto& p : ref["patches"]) elements += static_cast<long>(p["elements"].size());
+    CHECK(elements == cmp["exact"]["elements"].get<long>());
+    // The patches the comparison names carry the file's radiosities.
+    REQUIRE(cmp["hierarchical"]["error"]["largest"].size() >= 1);
+    for (const auto& l : cmp["hierarchical"]["error"]["largest"]) {
+        const auto& file_b = ref["patches"][l["patch"].get<size_t>()]["radiosity"];
+        CHECK(file_b[0].get<double>() == l["reference"][0].get<double>());
+    }
+    fs::remove(ref_path);
+    fs::remove(out_path);
+
+    // One file for both, or a directory that does not exist: status 2, nothing written.
+    const Run same = run({"compare", scene, "-q", "--reference-output", out_path, "-o", out_path});
+    CHECK(same.status == 2);
+    CHECK(same.err.find("same file") != std::string::npos);
+    const Run missing = run({"compare", scene, "-q", "--reference-output", stem + "_no/dir/ref.json"});
+    CHECK(missing.status == 2);
+    CHECK(missing.err.find("--reference-output") != std::string::npos);
+    CHECK_FALSE(fs::exists(out_path));
+    fs::remove(scene);
+}
+
 TEST_CASE("compare: the mesh limit stops the doubling and says so") {
     const std::string scene = write_scene(pillar_box);
     // 8 patches: K = 4 (32 elements) fits alone, but a first pair must fit
