@@ -87,7 +87,7 @@ ExactMesh graded_step(const Scene& scene, const Solution& coarse, const Solution
         return added;
     };
     // An equal share of the target for each element, raised until it fits.
-    // (A target of 0 or below rounding: start from the smallest indicator.)
+    // (A target of 0, or one below rounding: start far below the largest.)
     const double largest = *std::max_element(eta.begin(), eta.end());
     if (!(largest > 0)) return mesh;
     double tau2 = target2 / static_cast<double>(eta.size());
@@ -176,6 +176,7 @@ Reference solve_reference(const Scene& scene, const ReferenceOptions& options,
         ref.steps.push_back({coarse_K, coarse.stats.elements, ref.error_estimate, judged});
         if (ref.error_estimate <= judged / reference_margin) {
             ref.reached = true;
+            ref.stopped.clear();  // (the uniform doubling's stop, when grading reached it)
             return true;
         }
         if (ref.error_estimate <= reference_rounding_floor) {
@@ -202,8 +203,9 @@ Reference solve_reference(const Scene& scene, const ReferenceOptions& options,
     while (true) {
         if (!reference_fits(scene, 2 * K, options.max_elements / 2)) {
             ref.stopped = fmt::format("K = {} ({} elements) would pass {}", 2 * K, patches * 2 * K,
-                                      patches * 2 * K > options.max_elements ? "--max-elements"
-                                                                              : "the exact solver's memory limit");
+                                      patches * 2 * K > options.max_elements / 2
+                                          ? "half of --max-elements (the other half is kept for grading)"
+                                          : "the exact solver's memory limit");
             break;
         }
         exact(2 * K);

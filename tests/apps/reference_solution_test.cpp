@@ -205,5 +205,19 @@ TEST_CASE("solve_reference: a graded mesh puts its elements where a uniform one 
     // And its estimate (of the pair's coarser solve) must hold for the
     // reference itself, the finer one.
     CHECK(graded_error <= r.error_estimate);
+
+    // A judged error the uniform pairs cannot serve but a graded one can
+    // (5e-3: a target of 5e-4; K = 2 against 4 estimates 4.9e-2): reached,
+    // and nothing is said to have stopped it.
+    constexpr double judged = 5e-3;
+    const flatrad::Reference g =
+        flatrad::solve_reference(scene, small(4, cap), [](const flatrad::Solution&) { return judged; });
+    REQUIRE(!g.steps.empty());
+    MESSAGE("the uniform pair's estimate: ", g.steps.front().error_estimate);
+    CHECK(g.steps.front().error_estimate > judged / flatrad::reference_margin);
+    CHECK(g.reached);
+    CHECK(g.stopped.empty());
+    CHECK(g.subdivide() == 0);
+    CHECK(g.error_estimate <= judged / flatrad::reference_margin);
     CHECK(patches == 10);
 }
