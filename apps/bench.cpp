@@ -109,7 +109,7 @@ constexpr const char* usage_text =
     "         relative L2 error (as `flatrad compare`), speed-up; the largest eps with error <= 1%.\n"
     "         --reference-check also solves exactly at 2K to estimate the reference's own error.\n"
     "         --graded-reference MAX also builds `flatrad compare`'s reference (graded, at most MAX\n"
-    "         elements, its own error a tenth of 1%) and judges the 1% against it (rel_l2_ref).\n"
+    "         elements, its own error a hundredth of 1%) and judges the 1% against it (rel_l2_ref).\n"
     "         Eps run largest first; smaller ones stop once one is slower than exact (--all-eps: not).\n"
     "         Defaults: M 4000, eps 2,1,0.5,0.2,0.1,0.05,0.02,0.01, N 1000, D 30, L 1, S 1, R 3, T 0.\n"
     "  all    ffcost, matrix and rooms with their defaults (rooms: E >= 4000 run once).\n";
@@ -1208,8 +1208,9 @@ void run_versus(VersusOptions o, const std::string& cmd) {
                    2 * K, fine->stats.elements, fine_s, e.relative_l2, e.max_relative);
     }
     // The graded reference (cli/reference_solution.h, as `flatrad compare`
-    // builds it): good to a tenth of the 1% goal, so that "1%" is judged
-    // against the solution rather than against the K mesh's own error.
+    // builds it): good to a hundredth of the 1% goal, so that "1%" is
+    // judged against the solution to two digits rather than against the K
+    // mesh's own error (on the 1000-segment forest K = 2 is 1.7e-3 off).
     std::optional<flatrad::Reference> graded;
     if (o.graded_reference > 0) {
         flatrad::ReferenceOptions ro;
@@ -1220,12 +1221,12 @@ void run_versus(VersusOptions o, const std::string& cmd) {
             fmt::print(stderr, "versus: graded reference: exact, {} ...\n", flatrad::reference_mesh_name(k, n));
         };
         t0 = Clock::now();
-        graded = flatrad::solve_reference(scene, ro, [](const flatrad::Solution&) { return versus_error_goal; });
+        graded = flatrad::solve_reference(scene, ro, [](const flatrad::Solution&) { return versus_error_goal / 10; });
         const flatrad::CompareError e = flatrad::compare_solutions(scene, exact, graded->solution());
         fmt::print("graded reference: {} ({:.1f} s in all), its own error estimated at {:.3e} ({}), {}; the K\n"
                    "       solution is {:.3e} from it. rel_l2_ref is against it, and so is the 1% below.\n",
                    graded->mesh_name(), seconds_since(t0), graded->error_estimate, graded->estimate_from,
-                   graded->reached ? "a tenth of the 1% goal or less" : "NOT a tenth of the goal: " + graded->stopped,
+                   graded->reached ? "a hundredth of the 1% goal or less" : "NOT a hundredth of the goal: " + graded->stopped,
                    e.relative_l2);
     }
     std::fflush(stdout);
