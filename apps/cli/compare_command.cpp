@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <filesystem>
 #include <cmath>
 #include <limits>
 #include <ostream>
@@ -131,7 +132,9 @@ int run_compare(const CompareArgs& args, std::ostream& out, std::ostream& err) {
         throw UsageError(fmt::format("--threads: expected an integer >= 0, got {}", args.threads));
     if (!args.output.empty()) check_output_path(args.output, "-o");
     if (!args.reference_output.empty()) check_output_path(args.reference_output, "--reference-output");
-    if (!args.output.empty() && args.output == args.reference_output)
+    if (!args.output.empty() && !args.reference_output.empty() &&
+        std::filesystem::absolute(args.output).lexically_normal() ==
+            std::filesystem::absolute(args.reference_output).lexically_normal())
         throw UsageError(fmt::format("-o and --reference-output name the same file: {}", args.output));
 
     const Scene scene = load_scene_reporting(args.scene, err);

@@ -148,7 +148,8 @@ TEST_CASE("compare: --reference-output writes the reference's result file, the o
     fs::remove(out_path);
 
     // One file for both, or a directory that does not exist: status 2, nothing written.
-    const Run same = run({"compare", scene, "-q", "--reference-output", out_path, "-o", out_path});
+    const Run same = run({"compare", scene, "-q", "--reference-output", out_path, "-o",
+                          (fs::path(out_path).parent_path() / "." / fs::path(out_path).filename()).string()});
     CHECK(same.status == 2);
     CHECK(same.err.find("same file") != std::string::npos);
     const Run missing = run({"compare", scene, "-q", "--reference-output", stem + "_no/dir/ref.json"});
