@@ -1,3 +1,5 @@
+#include <string>
+
 #include <fmt/format.h>
 
 #include "engine/error.h"
@@ -24,16 +26,30 @@ double exact_solver_memory_bytes_for(const Scene& scene, double n) {
     return matrices + n * per_element;
 }
 
-void check_exact_solver_memory(const Scene& scene, int K) {
-    const double bytes = exact_solver_memory_bytes(scene, K);
+namespace {
+
+// Throws when n elements would pass the limit; `what` says what they are,
+// `path` and `advice` where the fault is and what to do.
+void check_memory(const Scene& scene, double n, const std::string& what, const std::string& path,
+                  const std::string& advice) {
+    const double bytes = exact_solver_memory_bytes_for(scene, n);
     if (bytes <= exact_solver_memory_limit_bytes) return;
-    const double n = static_cast<double>(scene.patches.size()) * static_cast<double>(K);
-    throw InputError(
-        scene.file, K > 1 ? "--subdivide" : "",
-        fmt::format("{:.0f} elements ({} patches x {}) would need {:.1f} GiB for the exact solver "
-                    "(three dense elements^2 matrices of doubles); the limit is {:.0f} GiB: {}",
-                    n, scene.patches.size(), K, bytes / gib, exact_solver_memory_limit_bytes / gib,
-                    K > 1 ? "lower --subdivide" : "use fewer segments"));
+    throw InputError(scene.file, path,
+                     fmt::format("{:.0f} elements ({}) would need {:.1f} GiB for the exact solver "
+                                 "(three dense elements^2 matrices of doubles); the limit is {:.0f} GiB: {}",
+                                 n, what, bytes / gib, exact_solver_memory_limit_bytes / gib, advice));
+}
+
+}  // namespace
+
+void check_exact_solver_memory(const Scene& scene, int K) {
+    check_memory(scene, static_cast<double>(scene.patches.size()) * static_cast<double>(K),
+                 fmt::format("{} patches x {}", scene.patches.size(), K), K > 1 ? "--subdivide" : "",
+                 K > 1 ? "lower --subdivide" : "use fewer segments");
+}
+
+void check_exact_solver_memory(const Scene& scene, const ExactMesh& mesh) {
+    check_memory(scene, static_cast<double>(mesh.elements()), "a graded mesh", "", "use a coarser mesh");
 }
 
 }  // namespace flatrad

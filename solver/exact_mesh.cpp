@@ -24,19 +24,27 @@ ExactMesh uniform_mesh(const Scene& scene, int K) {
 
 namespace {
 
-// One patch's cuts with element e (0-based, from t = 0) cut at its
-// midpoint where split(e) says so.
-template <class Split>
-std::vector<double> cut_patch(const std::vector<double>& cuts, Split split) {
+// Appends the cuts that halve [t0, t1] `level` times over, in order; a
+// piece too short to halve in floating point stays whole.
+void bisect(double t0, double t1, int level, std::vector<double>& out) {
+    const double mid = 0.5 * (t0 + t1);
+    if (level <= 0 || !(t0 < mid && mid < t1)) return;
+    bisect(t0, mid, level - 1, out);
+    out.push_back(mid);
+    bisect(mid, t1, level - 1, out);
+}
+
+// One patch's cuts with element e (0-based, from t = 0) halved level(e)
+// times over.
+template <class Level>
+std::vector<double> cut_patch(const std::vector<double>& cuts, Level level) {
     std::vector<double> out;
     out.reserve(2 * cuts.size() + 1);
     const size_t n = cuts.size() + 1;
     for (size_t e = 0; e < n; ++e) {
         const double t0 = e == 0 ? 0.0 : cuts[e - 1], t1 = e + 1 == n ? 1.0 : cuts[e];
         if (e > 0) out.push_back(t0);
-        // (An element too short to cut in floating point stays whole.)
-        const double mid = 0.5 * (t0 + t1);
-        if (split(e) && t0 < mid && mid < t1) out.push_back(mid);
+        bisect(t0, t1, level(e), out);
     }
     return out;
 }
@@ -46,19 +54,19 @@ std::vector<double> cut_patch(const std::vector<double>& cuts, Split split) {
 ExactMesh halved(const ExactMesh& mesh) {
     ExactMesh m;
     m.cuts.reserve(mesh.cuts.size());
-    for (const auto& c : mesh.cuts) m.cuts.push_back(cut_patch(c, [](size_t) { return true; }));
+    for (const auto& c : mesh.cuts) m.cuts.push_back(cut_patch(c, [](size_t) { return 1; }));
     return m;
 }
 
-ExactMesh split_marked(const ExactMesh& mesh, const std::vector<char>& marked) {
-    if (static_cast<long>(marked.size()) != mesh.elements())
+ExactMesh split_levels(const ExactMesh& mesh, const std::vector<int>& level) {
+    if (static_cast<long>(level.size()) != mesh.elements())
         throw std::invalid_argument(
-            fmt::format("split_marked: {} flags for {} elements", marked.size(), mesh.elements()));
+            fmt::format("split_levels: {} levels for {} elements", level.size(), mesh.elements()));
     ExactMesh m;
     m.cuts.reserve(mesh.cuts.size());
     size_t first = 0;  // the patch's first element
     for (const auto& c : mesh.cuts) {
-        m.cuts.push_back(cut_patch(c, [&](size_t e) { return marked[first + e] != 0; }));
+        m.cuts.push_back(cut_patch(c, [&](size_t e) { return level[first + e]; }));
         first += c.size() + 1;
     }
     return m;

@@ -27,11 +27,12 @@ ExactMesh uniform_mesh(const Scene& scene, int K);
 /// Every element of `mesh` cut at its midpoint.
 ExactMesh halved(const ExactMesh& mesh);
 
-/// `mesh` with the elements whose `marked` flag is set cut at their
-/// midpoints. Elements are numbered patch by patch, in increasing t within
-/// each patch (as solve_exact lists them in a solution's patches).
-/// Pre: marked.size() == mesh.elements().
-ExactMesh split_marked(const ExactMesh& mesh, const std::vector<char>& marked);
+/// `mesh` with element e halved level[e] times over (into 2^level[e]
+/// pieces; 0 leaves it whole). Elements are numbered patch by patch, in
+/// increasing t within each patch (as solve_exact lists them in a
+/// solution's patches). A piece too short to halve in floating point
+/// stays whole. Pre: level.size() == mesh.elements(), levels >= 0.
+ExactMesh split_levels(const ExactMesh& mesh, const std::vector<int>& level);
 
 /// Throws std::invalid_argument unless `mesh` has one entry per patch of
 /// `scene` and every patch's cuts are finite, strictly increasing and

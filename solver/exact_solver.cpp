@@ -40,13 +40,7 @@ Solution solve(const Scene& scene, const ExactMesh* mesh, const ExactSolverOptio
     const int K = mesh ? 0 : options.subdivide;
     if (mesh) {
         check_mesh(scene, *mesh);
-        const double bytes = exact_solver_memory_bytes_for(scene, static_cast<double>(mesh->elements()));
-        if (bytes > exact_solver_memory_limit_bytes)
-            throw InputError(scene.file, "",
-                             fmt::format("a mesh of {} elements would need {:.1f} GiB for the exact solver; the limit "
-                                         "is {:.0f} GiB",
-                                         mesh->elements(), bytes / (1024.0 * 1024 * 1024),
-                                         exact_solver_memory_limit_bytes / (1024.0 * 1024 * 1024)));
+        check_exact_solver_memory(scene, *mesh);
     } else {
         if (K < 1) throw InputError(scene.file, "--subdivide", fmt::format("expected an integer >= 1, found {}", K));
         check_exact_solver_memory(scene, K);

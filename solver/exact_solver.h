@@ -36,6 +36,8 @@ double exact_solver_memory_bytes_for(const Scene& scene, double elements);
 /// solve_exact calls it first; callers may call it earlier (before other
 /// work, as the CLI does).
 void check_exact_solver_memory(const Scene& scene, int K);
+/// The same for a mesh's elements (no flag named).
+void check_exact_solver_memory(const Scene& scene, const ExactMesh& mesh);
 
 /// Throws InputError when the system has no unique solution (a closed
 /// enclosure of reflectance 1 without absorber, in some channel), naming

@@ -108,23 +108,7 @@ ExactMesh graded_step(const Scene& scene, const Solution& coarse, const Solution
             else added += more;
         }
     }
-    for (int r = 0; r < max_graded_level; ++r) {
-        std::vector<char> marked(level.size());
-        std::vector<int> next;
-        next.reserve(2 * level.size());
-        for (size_t e = 0; e < level.size(); ++e) {
-            marked[e] = level[e] > r;
-            next.push_back(level[e]);
-            if (marked[e]) next.push_back(level[e]);
-        }
-        if (std::find(marked.begin(), marked.end(), 1) == marked.end()) break;
-        mesh = split_marked(mesh, marked);
-        // (An element too short to cut stays whole: its flags then no
-        // longer line up with the mesh's elements, and the cutting ends.)
-        if (mesh.elements() != static_cast<long>(next.size())) break;
-        level = std::move(next);
-    }
-    return mesh;
+    return split_levels(mesh, level);
 }
 
 double squared_norm(const Scene& scene, const Solution& s) {

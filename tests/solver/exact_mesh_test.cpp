@@ -35,14 +35,18 @@ TEST_CASE("exact mesh: uniform, halved and marked cuts") {
     CHECK(h.elements() == 2 * u.elements());
     CHECK(h.cuts[0] == std::vector<double>{0.125, 0.25, 0.375, 0.5, 0.625, 0.75, 0.875});
     // Marking the first patch's second element and the second patch's last.
-    std::vector<char> marked(static_cast<size_t>(u.elements()), 0);
+    std::vector<int> marked(static_cast<size_t>(u.elements()), 0);
     marked[1] = 1;
     marked[7] = 1;
-    const ExactMesh m = split_marked(u, marked);
+    const ExactMesh m = split_levels(u, marked);
     CHECK(m.elements() == u.elements() + 2);
     CHECK(m.cuts[0] == std::vector<double>{0.25, 0.375, 0.5, 0.75});
     CHECK(m.cuts[1] == std::vector<double>{0.25, 0.5, 0.75, 0.875});
-    CHECK_THROWS_AS(split_marked(u, std::vector<char>(3, 1)), std::invalid_argument);
+    CHECK_THROWS_AS(split_levels(u, std::vector<int>(3, 1)), std::invalid_argument);
+    // Level 2: the element halved twice over, into quarters.
+    std::vector<int> twice(static_cast<size_t>(u.elements()), 0);
+    twice[0] = 2;
+    CHECK(split_levels(u, twice).cuts[0] == std::vector<double>{0.0625, 0.125, 0.1875, 0.25, 0.5, 0.75});
     CHECK_THROWS_AS(uniform_mesh(scene, 0), std::invalid_argument);
     // An element too short to cut in floating point stays whole.
     ExactMesh tiny;
@@ -98,13 +102,13 @@ TEST_CASE("exact solver on a graded mesh: energy balance, white furnace, length-
     // Cut unevenly: patch p's first element cut p + 1 times more.
     ExactMesh m = uniform_mesh(scene, 2);
     for (int r = 0; r < 3; ++r) {
-        std::vector<char> marked(static_cast<size_t>(m.elements()), 0);
+        std::vector<int> marked(static_cast<size_t>(m.elements()), 0);
         size_t first = 0;
         for (size_t p = 0; p < m.cuts.size(); ++p) {
             if (static_cast<int>(p) % 3 >= r) marked[first] = 1;
             first += m.cuts[p].size() + 1;
         }
-        m = split_marked(m, marked);
+        m = split_levels(m, marked);
     }
     const Solution s = solve_exact(scene, m);
     // A closed room: emitted = absorbed to rounding (the dense LU's
@@ -132,9 +136,9 @@ TEST_CASE("exact solver on a graded mesh: energy balance, white furnace, length-
                    {"name": "plate", "material": "m", "points": [[0.3,0.4],[0.9,0.7]], "side": "both"}]})",
                                       "furnace.json");
     ExactMesh fm = uniform_mesh(furnace, 3);
-    std::vector<char> marked(static_cast<size_t>(fm.elements()), 0);
+    std::vector<int> marked(static_cast<size_t>(fm.elements()), 0);
     for (size_t e = 0; e < marked.size(); e += 2) marked[e] = 1;
-    const Solution f = solve_exact(furnace, split_marked(fm, marked));
+    const Solution f = solve_exact(furnace, split_levels(fm, marked));
     for (const PatchResult& pr : f.patches)
         for (const ElementValue& v : pr.elements) CHECK(v.B[0] == doctest::Approx(1000.0).epsilon(furnace_tol));
 }
