@@ -12,6 +12,7 @@
 #include <cmath>
 #include <future>
 #include <limits>
+#include <memory>
 #include <mutex>
 #include <numbers>
 #include <optional>
@@ -19,6 +20,7 @@
 #include <unordered_map>
 #include <fmt/format.h>
 
+#include "engine/box_cut.h"
 #include "engine/compensated_sum.h"
 #include "engine/connectivity.h"
 #include "engine/convex_scene.h"
@@ -260,6 +262,20 @@ constexpr double deferred_share = 0.1;
 // 0.01: 7.2e-3); the 1000-segment forest at eps 10 11 152 links instead of
 // 12 476, balance 3.4e-3 against 3.2e-3 (share 0.1: 6 049 and 1.6e-2).
 constexpr double unresolved_share = 1e-3;
+
+// A cluster end whose box a blocker outside it cuts in two (engine/
+// box_cut.h): the transmittance to its cross-section says nothing of its
+// members, which lie on either side of that blocker, so the link's
+// transmittance may be anywhere in [0, 1] for them (link_error counts
+// max(tau, 1 - tau) of its unoccluded power, on that end). A share of the
+// bar, as for deferred links: the error has one sign on every link to
+// that end (a blocker between the box's centre and the members that face
+// the link hides them from every sender at once). A small shelf-and-book
+// scene (docs/solver-history.md, "Forty-fourth session") at the default
+// eps: the shelf's end face at 0.49 for 1.41 before; 1.39 with this,
+// 1.16 with a share of 0.3, 0.99 with the whole bar (its ~30 links each
+// under the bar, all too dark).
+constexpr double cut_box_share = 0.1;
 
 // The first refinement is against the emission alone (run) where the scene
 // holds at least this many layers of shadow across (its density times the
@@ -657,6 +673,8 @@ public:
         m_visible_sink = std::move(facts.visible_sink);
         m_side_room = std::move(facts.side_room);
         convex_object_skips(facts.conn);
+        m_box_cut = std::make_unique<std::atomic<int8_t>[]>(m_hierarchy.nodes().size());
+        for (size_t h = 0; h < m_hierarchy.nodes().size(); ++h) m_box_cut[h].store(-1, std::memory_order_relaxed);
         const bool sinks = std::find(m_visible_sink.begin(), m_visible_sink.end(), 1) != m_visible_sink.end();
         // A lit patch that neither reflects nor emits, in any channel, sends
         // nothing, so no link has it as its sender (gather_from_children's
@@ -851,6 +869,12 @@ private:
     // does not count as blockers (itself, or its highest ancestor made of
     // the same convex closed loop: see convex_object_skips).
     std::vector<int32_t> m_tau_skip;
+    // Per hierarchy node: whether a blocker other than its m_tau_skip
+    // node's segments cuts its box in two (engine/box_cut.h; link_error's
+    // cut_box_share); -1 until asked. Asked from the refinement's threads:
+    // the same answer whichever asks first.
+    mutable std::unique_ptr<std::atomic<int8_t>[]> m_box_cut;
+    bool box_cut(int h) const;
     // Chain links (mark_chains, chain_etendue): the convex loops, and per
     // segment its loop and place in the loop's cycle (-1: none); per
     // cluster table the ends of its chain, oriented with the room on the
@@ -1064,6 +1088,17 @@ void HierarchicalSolver::convex_object_skips(const Connectivity& conn) {
         if (node_loop[h] >= 0 && p >= 0 && node_loop[static_cast<size_t>(p)] == node_loop[h])
             m_tau_skip[h] = m_tau_skip[static_cast<size_t>(p)];
     }
+}
+
+bool HierarchicalSolver::box_cut(int h) const {
+    std::atomic<int8_t>& known = m_box_cut[static_cast<size_t>(h)];
+    const int8_t k = known.load(std::memory_order_relaxed);
+    if (k >= 0) return k != 0;
+    const ClusterNode& skip = m_hierarchy.node(m_tau_skip[static_cast<size_t>(h)]);
+    thread_local std::vector<int32_t> stack;
+    const bool cut = box_cut_by_blocker(m_hierarchy, m_hierarchy.node(h).box, skip.first, skip.count, stack);
+    known.store(cut ? 1 : 0, std::memory_order_relaxed);
+    return cut;
 }
 
 // One tree: hierarchy nodes (clusters), then under each hierarchy leaf the
@@ -2484,6 +2519,10 @@ LinkError HierarchicalSolver::link_error(const Link& l, const std::vector<double
     // side narrows the shaft most.
     const double vis = std::min(tau, 1 - tau) + l.vis_err;
     const double seen = std::min(1.0, tau + l.vis_err);
+    // A cluster end cut in two by a blocker not its own: its members may
+    // see anything of the other end (cut_box_share), counted on its side.
+    if (r.cluster() && box_cut(r.hnode)) rel_r += std::max(tau, 1 - tau) / cut_box_share;
+    if (s.cluster() && box_cut(s.hnode)) rel_s += std::max(tau, 1 - tau) / cut_box_share;
     const double err = unocc * (rel_r + rel_s + vis) + seen * (spread_r + spread_s);
     // (A NaN here is compared false against every bar: such a link was
     // neither split nor deferred, but asked, whatever its error.)
