@@ -122,8 +122,9 @@ double squared_norm(const Scene& scene, const Solution& s) {
 
 Reference solve_reference(const Scene& scene, const ReferenceOptions& options,
                           const std::function<double(const Solution& candidate)>& compared_error) {
-    if (!reference_fits(scene, options.subdivide, options.max_elements))
-        throw std::invalid_argument(fmt::format("solve_reference: K = {} does not fit", options.subdivide));
+    if (options.subdivide < 1 || !reference_fits(scene, 1, options.max_elements))
+        throw std::invalid_argument(
+            fmt::format("solve_reference: K = {}, or one element per patch, does not fit", options.subdivide));
     const long patches = static_cast<long>(scene.patches.size());
     Reference ref;
     auto record = [&](Solution s, long K) {

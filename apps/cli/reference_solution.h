@@ -137,9 +137,11 @@ struct Reference {
 /// Builds the reference for `scene` as above. `compared_error(candidate)`
 /// is the error being judged, measured against a candidate reference (for
 /// one solution S: compare_solutions(scene, S, candidate).relative_l2).
-/// Pre: reference_fits(scene, options.subdivide, options.max_elements)
-/// (throws std::invalid_argument otherwise: callers check it first, with
-/// a message naming their own flags). Exceptions of the exact solver
+/// Pre: options.subdivide >= 1 and reference_fits(scene, 1,
+/// options.max_elements): one element per patch fits, as the first K is
+/// halved down to 1 while its pair does not (throws std::invalid_argument
+/// otherwise: callers check it first, with a message naming their own
+/// flags). Exceptions of the exact solver
 /// (InputError for a scene it refuses) pass through.
 Reference solve_reference(const Scene& scene, const ReferenceOptions& options,
                           const std::function<double(const Solution& candidate)>& compared_error);

@@ -114,12 +114,24 @@ TEST_CASE("compare: -o writes the file; bad flags give status 2") {
     for (const std::vector<std::string>& bad :
          {std::vector<std::string>{"compare", scene, "--eps", "0"},
           std::vector<std::string>{"compare", scene, "--subdivide", "0"},
-          std::vector<std::string>{"compare", scene, "--subdivide", "1000", "--max-elements", "100"},
+          std::vector<std::string>{"compare", scene, "--max-elements", "7"},  // 8 patches: not one element each
           std::vector<std::string>{"compare", scene, "--max-elements", "0"}}) {
         const Run b = run(bad);
         CHECK(b.status == 2);
         CHECK(b.err.rfind("error: ", 0) == 0);
     }
+    // A first K beyond the cap is halved until its pair fits in half the
+    // cap, not refused (8 patches, K = 1000 against a cap of 100: halved to
+    // 3, its pair of 48 elements within 50); the refusal is for a cap below
+    // one element per patch, which no halving helps.
+    const Run big = run({"compare", scene, "-q", "--eps", "0.05", "--subdivide", "1000", "--max-elements", "100"});
+    REQUIRE(big.status == 0);
+    const json jb = json::parse(big.out);
+    REQUIRE(jb["reference"]["steps"].size() >= 1);
+    CHECK(jb["reference"]["steps"][0]["subdivide"].get<long>() == 3);
+    const Run cap = run({"compare", scene, "--max-elements", "7"});
+    CHECK(cap.err.find("--max-elements 7") != std::string::npos);
+    CHECK(cap.err.find("raise --max-elements") != std::string::npos);
     fs::remove(scene);
 }
 

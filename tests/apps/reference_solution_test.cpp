@@ -111,8 +111,18 @@ TEST_CASE("solve_reference: the element cap stops the doubling, and says so") {
     CHECK(std::isinf(alone.error_estimate));
     CHECK(std::isnan(alone.estimate_max_relative));
 
+    // A first K that does not fit is halved like any other (K = 32 under a
+    // cap of 128: 16 would fit alone, but the first pair must fit in 64,
+    // so K = 4 against 8); only a cap below one element per patch, which
+    // no halving helps, is refused, and K < 1.
     CHECK_FALSE(flatrad::reference_fits(scene, 32, 8 * 16));
-    CHECK_THROWS_AS(flatrad::solve_reference(scene, small(32, 8 * 16), [](const flatrad::Solution&) { return 1.0; }),
+    const flatrad::Reference from_32 =
+        flatrad::solve_reference(scene, small(32, 8 * 16), [](const flatrad::Solution&) { return 1.0; });
+    REQUIRE(from_32.ladder_subdivide.size() >= 2);
+    CHECK(from_32.ladder_subdivide[0] == 4);
+    CHECK_THROWS_AS(flatrad::solve_reference(scene, small(1, 7), [](const flatrad::Solution&) { return 1.0; }),
+                    std::invalid_argument);
+    CHECK_THROWS_AS(flatrad::solve_reference(scene, small(0, 8 * 16), [](const flatrad::Solution&) { return 1.0; }),
                     std::invalid_argument);
 }
 

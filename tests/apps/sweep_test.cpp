@@ -404,7 +404,7 @@ TEST_CASE("sweep (whole solutions): bad arguments give status 2, one line, and w
         {"sweep", closed_box, "--subdivide", "0"},
         {"sweep", closed_box, "--max-elements", "0"},
         {"sweep", closed_box, "--threads", "-1"},
-        {"sweep", closed_box, "--subdivide", "64", "--max-elements", "100"},  // first mesh beyond the cap
+        {"sweep", closed_box, "--max-elements", "3"},  // 4 patches: not one element each within the cap
         {"sweep", closed_box, "-o", tmp.path("no/such/dir.csv")},
         {"sweep", closed_box, "--svg", tmp.path("no/such/prefix")},
         {"sweep", tmp.path("missing.json")},
