@@ -13,18 +13,10 @@ bool segment_cuts_box(const Segment& s, const Box& b) {
                                    std::abs(b.hi.y), std::abs(s.a.x), std::abs(s.a.y), std::abs(s.b.x),
                                    std::abs(s.b.y)});
     const double tol = 1e-9 * scale;
-    // The part of s inside b: parameters [t0, t1] (Liang and Barsky 1984).
-    double t0 = 0, t1 = 1;
+    // The part of s inside b: parameters [t0, t1], of some length.
+    double t0, t1;
+    if (!clip_to_box(s.a, s.b, b, t0, t1) || !(t0 < t1)) return false;
     const Vec2 d = s.b - s.a;
-    auto clip = [&](double p, double dp, double lo, double hi) {
-        if (dp == 0) return p >= lo && p <= hi;
-        double ta = (lo - p) / dp, tb = (hi - p) / dp;
-        if (ta > tb) std::swap(ta, tb);
-        t0 = std::max(t0, ta);
-        t1 = std::min(t1, tb);
-        return t0 < t1;
-    };
-    if (!clip(s.a.x, d.x, b.lo.x, b.hi.x) || !clip(s.a.y, d.y, b.lo.y, b.hi.y)) return false;
     // How far inside b a point is (<= tol: on its boundary).
     auto depth = [&](Vec2 p) { return std::min({p.x - b.lo.x, b.hi.x - p.x, p.y - b.lo.y, b.hi.y - p.y}); };
     const Vec2 p0 = s.a + d * t0, p1 = s.a + d * t1;

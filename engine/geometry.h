@@ -105,12 +105,15 @@ inline bool boxes_apart(const Box& p, const Box& q) {
     return p.hi.x < q.lo.x || q.hi.x < p.lo.x || p.hi.y < q.lo.y || q.hi.y < p.lo.y;
 }
 
-/// Whether the segment from p to q meets the closed box b (clipping the
-/// segment's parameter range to each axis' slab, Liang and Barsky 1984; an
-/// axis along which the segment does not move needs p within the slab).
-inline bool segment_meets_box(Vec2 p, Vec2 q, const Box& b) {
+/// The part of the segment from p to q inside the closed box b: its
+/// parameter range [t0, t1] along p + t (q - p), clipped from [0, 1] to
+/// each axis' slab (Liang and Barsky 1984; an axis along which the segment
+/// does not move needs p within the slab). False when the segment misses
+/// b (t0 and t1 are then meaningless).
+inline bool clip_to_box(Vec2 p, Vec2 q, const Box& b, double& t0, double& t1) {
     if (b.empty()) return false;
-    double t0 = 0, t1 = 1;
+    t0 = 0;
+    t1 = 1;
     auto clip = [&](double p0, double d, double lo, double hi) {
         if (d == 0) return p0 >= lo && p0 <= hi;
         double ta = (lo - p0) / d, tb = (hi - p0) / d;
@@ -120,6 +123,12 @@ inline bool segment_meets_box(Vec2 p, Vec2 q, const Box& b) {
         return t0 <= t1;
     };
     return clip(p.x, q.x - p.x, b.lo.x, b.hi.x) && clip(p.y, q.y - p.y, b.lo.y, b.hi.y);
+}
+
+/// Whether the segment from p to q meets the closed box b.
+inline bool segment_meets_box(Vec2 p, Vec2 q, const Box& b) {
+    double t0, t1;
+    return clip_to_box(p, q, b, t0, t1);
 }
 
 }  // namespace flatrad
