@@ -28,7 +28,7 @@ bool segment_cuts_box(const Segment& s, const Box& b) {
 }
 
 bool box_cut_by_blocker(const Hierarchy& h, const Box& box, int32_t skip_first, int32_t skip_count,
-                        std::vector<int32_t>& stack) {
+                        std::vector<int32_t>& stack, double min_length) {
     if (h.root() < 0 || box.empty()) return false;
     const int32_t skip_end = skip_first + skip_count;
     stack.clear();
@@ -45,7 +45,8 @@ bool box_cut_by_blocker(const Hierarchy& h, const Box& box, int32_t skip_first, 
         }
         for (int32_t q = n.first; q < n.first + n.count; ++q) {
             if ((q >= skip_first && q < skip_end) || !h.can_block_at(q)) continue;
-            if (segment_cuts_box(h.segment_at(q), box)) return true;
+            const Segment& s = h.segment_at(q);
+            if (s.length() >= min_length && segment_cuts_box(s, box)) return true;
         }
     }
     return false;

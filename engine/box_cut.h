@@ -31,11 +31,12 @@ namespace flatrad {
 /// clipping's rounding, far below any scene's detail).
 bool segment_cuts_box(const Segment& s, const Box& b);
 
-/// Whether some segment of `h` that can block (Hierarchy::can_block), other
-/// than those at places [skip_first, skip_first + skip_count) of h.order(),
-/// cuts `box` in two (segment_cuts_box). Walks the hierarchy's nodes whose
-/// boxes meet `box`; `stack` is scratch.
+/// Whether some segment of `h` that can block (Hierarchy::can_block), at
+/// least `min_length` long, other than those at places [skip_first,
+/// skip_first + skip_count) of h.order(), cuts `box` in two
+/// (segment_cuts_box). Walks the hierarchy's nodes whose boxes meet `box`;
+/// `stack` is scratch.
 bool box_cut_by_blocker(const Hierarchy& h, const Box& box, int32_t skip_first, int32_t skip_count,
-                        std::vector<int32_t>& stack);
+                        std::vector<int32_t>& stack, double min_length = 0);
 
 }  // namespace flatrad

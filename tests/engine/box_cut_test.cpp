@@ -95,6 +95,9 @@ TEST_CASE("box_cut_by_blocker: finds a cutting blocker, leaving out the skipped 
         if (h.order()[q] == 3) bar = static_cast<int32_t>(q);
     REQUIRE(bar >= 0);
     CHECK(box_cut_by_blocker(h, members, 0, 0, stack));
+    // Only blockers at least min_length long count: the bar is 3 long.
+    CHECK(box_cut_by_blocker(h, members, 0, 0, stack, 3.0));
+    CHECK_FALSE(box_cut_by_blocker(h, members, 0, 0, stack, 3.01));
     // The bar's place skipped: nothing else cuts the box (the members lie
     // on its edges or inside it).
     CHECK_FALSE(box_cut_by_blocker(h, members, bar, 1, stack));
