@@ -20,7 +20,7 @@
 #include <unordered_map>
 #include <fmt/format.h>
 
-#include "engine/box_cut.h"
+#include "engine/box_intrusion.h"
 #include "engine/compensated_sum.h"
 #include "engine/connectivity.h"
 #include "engine/convex_scene.h"
@@ -263,27 +263,34 @@ constexpr double deferred_share = 0.1;
 // 12 476, balance 3.4e-3 against 3.2e-3 (share 0.1: 6 049 and 1.6e-2).
 constexpr double unresolved_share = 1e-3;
 
-// A cluster end whose box a blocker outside it cuts in two (engine/
-// box_cut.h): the transmittance to its cross-section says nothing of its
-// members, which lie on either side of that blocker, so the link's
-// transmittance may be anywhere in [0, 1] for them (link_error counts
-// max(tau, 1 - tau) of its unoccluded power, on that end). A share of the
-// bar, as for deferred links: the error has one sign on every link to
-// that end (a blocker between the box's centre and the members that face
-// the link hides them from every sender at once). A small shelf-and-book
-// scene (docs/solver-history.md, "Forty-fourth session") at the default
-// eps: the shelf's end face at 0.49 for 1.41 before; 1.39 with this,
-// 1.16 with a share of 0.3, 0.99 with the whole bar (its ~30 links each
-// under the bar, all too dark).
-// Only blockers at least as long as the box's diagonal count (box_cut):
-// one of the members' own scale is scattered among them as they are (a
-// forest's sticks), which the cross-section's mean stands for, while one
-// longer runs across the box like a wall. Counting every blocker cost the
-// 10^4 forest at eps 10 7.6% more instructions (its queries through the
-// split clusters' crowded shafts) for no change in its error; with this
-// length its links are what they were without the term, and the shelf
-// scenes and the furnished room keep their gains.
-constexpr double cut_box_share = 0.1;
+// A cluster end whose box a long blocker not its own runs through
+// (engine/box_intrusion.h): the transmittance to its cross-section says
+// nothing of its members, which lie on either side of that blocker, so the
+// link's transmittance may be anywhere in [0, 1] for them (link_error
+// counts max(tau, 1 - tau) of its unoccluded power, on that end). A share
+// of the bar, as for deferred links: the error has one sign on every link
+// to that end (a blocker between the box's centre and the members that
+// face the link hides them from every sender at once). A small
+// shelf-and-book scene (docs/solver-history.md, "Forty-fourth session") at
+// the default eps: the shelf's end face at 0.49 for 1.41 before; 1.39 with
+// this, 1.16 with a share of 0.3, 0.99 with the whole bar (its ~30 links
+// each under the bar, all too dark).
+constexpr double intruded_box_share = 0.1;
+
+// Which blockers intrude (box_intruded): at least as long as the box's
+// diagonal, and through at least a quarter of it. One of the members' own
+// scale is scattered among them as they are (a forest's sticks), which the
+// cross-section's mean stands for; one longer runs through the box like a
+// wall. Counting every blocker that cut a box in two cost the 10^4 forest
+// at eps 10 7.6% more instructions (its queries through the split
+// clusters' crowded shafts) for no change in its error; with the length,
+// the forests' links are what they were (10^5: one more). Cuts alone
+// missed a shelf's top ending inside the box (a piece straddling the
+// shelf's end: its top at 0.56 for 2.14); any chord through the interior
+// at all moved the 10^5 forest by 5.8e-4 (80 more links) for nothing
+// measured; from a quarter of the diagonal, the straddling piece's top is
+// 2.08 and the forests are as before.
+constexpr double intruder_min_chord = 0.25;
 
 // The first refinement is against the emission alone (run) where the scene
 // holds at least this many layers of shadow across (its density times the
@@ -681,8 +688,8 @@ public:
         m_visible_sink = std::move(facts.visible_sink);
         m_side_room = std::move(facts.side_room);
         convex_object_skips(facts.conn);
-        m_box_cut = std::make_unique<std::atomic<int8_t>[]>(m_hierarchy.nodes().size());
-        for (size_t h = 0; h < m_hierarchy.nodes().size(); ++h) m_box_cut[h].store(-1, std::memory_order_relaxed);
+        m_box_intruded = std::make_unique<std::atomic<int8_t>[]>(m_hierarchy.nodes().size());
+        for (size_t h = 0; h < m_hierarchy.nodes().size(); ++h) m_box_intruded[h].store(-1, std::memory_order_relaxed);
         const bool sinks = std::find(m_visible_sink.begin(), m_visible_sink.end(), 1) != m_visible_sink.end();
         // A lit patch that neither reflects nor emits, in any channel, sends
         // nothing, so no link has it as its sender (gather_from_children's
@@ -877,12 +884,12 @@ private:
     // does not count as blockers (itself, or its highest ancestor made of
     // the same convex closed loop: see convex_object_skips).
     std::vector<int32_t> m_tau_skip;
-    // Per hierarchy node: whether a blocker other than its m_tau_skip
-    // node's segments cuts its box in two (engine/box_cut.h; link_error's
-    // cut_box_share); -1 until asked. Asked from the refinement's threads:
-    // the same answer whichever asks first.
-    mutable std::unique_ptr<std::atomic<int8_t>[]> m_box_cut;
-    bool box_cut(int h) const;
+    // Per hierarchy node: whether a long blocker other than its m_tau_skip
+    // node's segments runs through its box (engine/box_intrusion.h;
+    // link_error's intruded_box_share); -1 until asked. Asked from the
+    // refinement's threads: the same answer whichever asks first.
+    mutable std::unique_ptr<std::atomic<int8_t>[]> m_box_intruded;
+    bool box_intruded(int h) const;
     // Chain links (mark_chains, chain_etendue): the convex loops, and per
     // segment its loop and place in the loop's cycle (-1: none); per
     // cluster table the ends of its chain, oriented with the room on the
@@ -1098,16 +1105,18 @@ void HierarchicalSolver::convex_object_skips(const Connectivity& conn) {
     }
 }
 
-bool HierarchicalSolver::box_cut(int h) const {
-    std::atomic<int8_t>& known = m_box_cut[static_cast<size_t>(h)];
+bool HierarchicalSolver::box_intruded(int h) const {
+    std::atomic<int8_t>& known = m_box_intruded[static_cast<size_t>(h)];
     const int8_t k = known.load(std::memory_order_relaxed);
     if (k >= 0) return k != 0;
     const ClusterNode& skip = m_hierarchy.node(m_tau_skip[static_cast<size_t>(h)]);
     thread_local std::vector<int32_t> stack;
     const Box& box = m_hierarchy.node(h).box;
-    const bool cut = box_cut_by_blocker(m_hierarchy, box, skip.first, skip.count, stack, box.diagonal());
-    known.store(cut ? 1 : 0, std::memory_order_relaxed);
-    return cut;
+    const double diagonal = box.diagonal();
+    const bool intruded = box_intruded_by_blocker(m_hierarchy, box, skip.first, skip.count, diagonal,
+                                                  intruder_min_chord * diagonal, stack);
+    known.store(intruded ? 1 : 0, std::memory_order_relaxed);
+    return intruded;
 }
 
 // One tree: hierarchy nodes (clusters), then under each hierarchy leaf the
@@ -2528,10 +2537,11 @@ LinkError HierarchicalSolver::link_error(const Link& l, const std::vector<double
     // side narrows the shaft most.
     const double vis = std::min(tau, 1 - tau) + l.vis_err;
     const double seen = std::min(1.0, tau + l.vis_err);
-    // A cluster end cut in two by a blocker not its own: its members may
-    // see anything of the other end (cut_box_share), counted on its side.
-    if (r.cluster() && box_cut(r.hnode)) rel_r += std::max(tau, 1 - tau) / cut_box_share;
-    if (s.cluster() && box_cut(s.hnode)) rel_s += std::max(tau, 1 - tau) / cut_box_share;
+    // A cluster end that a long blocker not its own runs through: its
+    // members may see anything of the other end (intruded_box_share),
+    // counted on its side.
+    if (r.cluster() && box_intruded(r.hnode)) rel_r += std::max(tau, 1 - tau) / intruded_box_share;
+    if (s.cluster() && box_intruded(s.hnode)) rel_s += std::max(tau, 1 - tau) / intruded_box_share;
     const double err = unocc * (rel_r + rel_s + vis) + seen * (spread_r + spread_s);
     // (A NaN here is compared false against every bar: such a link was
     // neither split nor deferred, but asked, whatever its error.)

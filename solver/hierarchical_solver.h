@@ -77,10 +77,11 @@
 ///    direction, its highest value over the nodes' angular spread: a
 ///    grazing lobe; a linear read's own variation over the spread, to
 ///    second order; a cluster end whose box a blocker not its own, at
-///    least as long as the box's diagonal, cuts in two, engine/box_cut.h:
-///    max(tau, 1 - tau) at a tenth of the bar, as the cross-section's
-///    transmittance says nothing of members on either side of that
-///    blocker); the side with the larger share is split. A cluster
+///    least as long as the box's diagonal, runs through for at least a
+///    quarter of it, engine/box_intrusion.h: max(tau, 1 - tau) at a tenth
+///    of the bar, as the cross-section's transmittance says nothing of
+///    members on either side of that blocker); the side with the larger
+///    share is split. A cluster
 ///    link's transmittance (an element link's occluded F) is asked only
 ///    when its geometric terms alone (which no visibility changes) do not
 ///    already exceed eps_abs: most links of an occluded scene are split on
