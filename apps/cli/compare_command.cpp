@@ -139,11 +139,7 @@ int run_compare(const CompareArgs& args, std::ostream& out, std::ostream& err) {
 
     const Scene scene = load_scene_reporting(args.scene, err);
     const long patches = static_cast<long>(scene.patches.size());
-    // (The first K is halved while its pair does not fit: K = 1 must.)
-    if (!reference_fits(scene, 1, args.max_elements))
-        throw UsageError(fmt::format("--max-elements {}: the exact reference needs at least one element per patch, "
-                                     "{} (or the exact solver's memory limit stops it); raise --max-elements",
-                                     args.max_elements, patches));
+    check_reference_cap(scene, args.max_elements);
 
     // 1. Hierarchical, its progress drawn on a terminal (cli/progress.h).
     HierarchicalOptions h_options;

@@ -8,10 +8,18 @@
 #include <fmt/format.h>
 
 #include "cli/solution_error.h"
+#include "cli/usage_error.h"
 #include "solver/exact_mesh.h"
 #include "solver/exact_solver.h"
 
 namespace flatrad {
+
+void check_reference_cap(const Scene& scene, long max_elements) {
+    if (!reference_fits(scene, 1, max_elements))
+        throw UsageError(fmt::format("--max-elements {}: the exact reference needs at least one element per patch, "
+                                     "{} (or the exact solver's memory limit stops it); raise --max-elements",
+                                     max_elements, scene.patches.size()));
+}
 
 bool reference_fits(const Scene& scene, long K, long max_elements) {
     const long patches = static_cast<long>(scene.patches.size());
@@ -208,11 +216,11 @@ Reference solve_reference(const Scene& scene, const ReferenceOptions& options,
         while (room > 0 && !elements_fit(scene, 2 * (n + room), options.max_elements)) room /= 2;
         // A step that may add only a few elements costs a whole pair of
         // solves for little: not below a twentieth of the mesh.
-        if (room < std::max(1L, n / graded_min_step)) room = 0;
+        const long least = std::max(1L, n / graded_min_step);
+        if (room < least) room = 0;
         const double target = ref.steps.back().compared_error / reference_margin;
         const ExactMesh mesh = graded_step(scene, coarse, fine, target * target * squared_norm(scene, fine), room);
         if (mesh.elements() == n) {
-            const long least = std::max(1L, n / graded_min_step);
             ref.stopped = room > 0 ? "no element left to cut"
                                    : fmt::format("a graded step from {} elements by at least {} would pass {}", n,
                                                  least,

@@ -93,6 +93,12 @@ struct ReferenceOptions {
 /// the exact solver's memory limit.
 bool reference_fits(const Scene& scene, long K, long max_elements);
 
+/// Throws UsageError (naming --max-elements) unless one element per patch
+/// fits under `max_elements` and the memory limit: the first K is halved
+/// down to 1 while its pair does not fit, so that is all a reference needs
+/// (what `flatrad compare` and `flatrad sweep` check before solving).
+void check_reference_cap(const Scene& scene, long max_elements);
+
 /// One pair of step 1: M against M halved.
 struct ReferenceStep {
     long subdivide = 0;          ///< K of M; 0 when M is graded

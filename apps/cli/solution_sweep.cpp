@@ -332,12 +332,7 @@ int run_solution_sweep_command(const SweepArgs& args, std::ostream& out, std::os
         for (const auto& [kind, path] : plots) check_output_path(path, "--svg");
 
     const Scene scene = load_scene_reporting(args.scene, err);
-    const long patches = static_cast<long>(scene.patches.size());
-    // (The first K is halved while its pair does not fit: K = 1 must.)
-    if (!reference_fits(scene, 1, o.reference.max_elements))
-        throw UsageError(fmt::format("--max-elements {}: the exact reference needs at least one element per patch, "
-                                     "{} (or the exact solver's memory limit stops it); raise --max-elements",
-                                     o.reference.max_elements, patches));
+    check_reference_cap(scene, o.reference.max_elements);
 
     if (!args.quiet)
         err << fmt::format("sweep: {}, {} eps from {:g} to {:g}, median of {} run{}\n", scene_label(scene),
