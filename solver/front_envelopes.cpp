@@ -179,11 +179,10 @@ public:
             pr.faces[q] = static_cast<uint8_t>((f.way[0] ? 1 : 0) | (f.way[1] ? 2 : 0));
         }
         // This pass's bins start unmeasured (shares 1, front NaN).
-        for (const int b : {k, k + half}) {
-            const size_t col = m_out.column(b);
-            std::fill_n(m_out.whole_by_bin.begin() + static_cast<std::ptrdiff_t>(col * m_out.clusters), m_out.clusters, 1.0);
-            std::fill_n(m_out.front_by_bin.begin() + static_cast<std::ptrdiff_t>(col * m_out.clusters), m_out.clusters, nan);
-            std::fill_n(m_out.group_by_bin.begin() + static_cast<std::ptrdiff_t>(col * m_out.groups), m_out.groups, 1.0);
+        for (const size_t bin : {static_cast<size_t>(k), static_cast<size_t>(k + half)}) {
+            std::fill_n(m_out.whole_by_bin.begin() + static_cast<std::ptrdiff_t>(bin * m_out.clusters), m_out.clusters, 1.0);
+            std::fill_n(m_out.front_by_bin.begin() + static_cast<std::ptrdiff_t>(bin * m_out.clusters), m_out.clusters, nan);
+            std::fill_n(m_out.group_by_bin.begin() + static_cast<std::ptrdiff_t>(bin * m_out.groups), m_out.groups, 1.0);
         }
         if (!finite) return;  // unmeasured
         const size_t H = m_h.nodes().size();
@@ -267,19 +266,19 @@ private:
                 m_seen[group_of(*it)] += width;
                 depth_sum += integral;
             }
-            const size_t col = m_out.column(m_k + w * half);
+            const size_t bin = static_cast<size_t>(m_k + w * half);
             double seen = 0, all = 0;
             for (size_t g = 0; g < G; ++g) {
                 const int32_t group = g0 + static_cast<int32_t>(g);
                 const double a = m_all[static_cast<size_t>(w)][static_cast<size_t>(m_c.group_node[static_cast<size_t>(group)])];
                 const double share = m_seen[g] / a;
-                m_out.group_by_bin[col * m_out.groups + static_cast<size_t>(group)] =
+                m_out.group_by_bin[bin * m_out.groups + static_cast<size_t>(group)] =
                     a > 0 && std::isfinite(share) ? std::clamp(share, 0.0, 1.0) : 1.0;
                 seen += m_seen[g];
                 all += a;
             }
             const double share = seen / all, mean = depth_sum / seen;
-            const size_t at = col * m_out.clusters + static_cast<size_t>(c);
+            const size_t at = bin * m_out.clusters + static_cast<size_t>(c);
             if (all > 0 && std::isfinite(share)) m_out.whole_by_bin[at] = std::clamp(share, 0.0, 1.0);
             m_out.front_by_bin[at] = seen > 0 && std::isfinite(mean) ? mean : nan;
         }
@@ -302,31 +301,37 @@ private:
 
 }  // namespace
 
-EnvelopeMeasure::EnvelopeMeasure(const Hierarchy& h, const std::vector<uint8_t>& sides_at,
-                                 const EnvelopeClusters& clusters)
-    : m_h(h), m_sides(sides_at), m_clusters(clusters) {
+EnvelopeShares cluster_visible_fractions(const Hierarchy& h, const std::vector<uint8_t>& sides_at,
+                                         const EnvelopeClusters& clusters, int threads) {
     const size_t C = clusters.node.size();
     FLATRAD_ASSERT(clusters.group_begin.size() == C + 1, "group_begin has one entry per cluster and one more");
     FLATRAD_ASSERT(sides_at.size() == h.order().size(), "one sides entry per place");
     const size_t G = clusters.group_node.size();
-    m_wanted.assign(h.nodes().size(), -1);
+    EnvelopeShares out;
+    out.clusters = C;
+    out.groups = G;
+    out.whole_by_bin.resize(C * K);  // (each pass writes its bins in full: DirectionPass::run)
+    out.group_by_bin.resize(G * K);
+    out.front_by_bin.resize(C * K);
+    std::vector<int32_t> wanted(h.nodes().size(), -1);
+    std::vector<int32_t> non_blockers;
     for (size_t q = 0; q < sides_at.size(); ++q)
-        if (!(sides_at[q] & blocks)) m_non_blockers.push_back(static_cast<int32_t>(q));
+        if (!(sides_at[q] & blocks)) non_blockers.push_back(static_cast<int32_t>(q));
     // Per cluster, found once for every pass: its groups as (first place,
     // group) by first place, at group_begin[c] on, and its non-blockers,
     // non_blockers[range.first, range.second). (Flat arrays: a vector per
     // cluster, and a search of the whole scene's non-blockers per cluster
     // and pass, kept the passes waiting on memory: 5.2 s -> 3.6 s on the
     // 10^6 forest, two threads.)
-    m_by_first.resize(G);
-    m_nb_range.assign(C, {0, 0});
+    std::vector<std::pair<int32_t, int32_t>> by_first(G);
+    std::vector<std::pair<int32_t, int32_t>> nb_range(C, {0, 0});
     for (size_t c = 0; c < C; ++c) {
         const ClusterNode& n = h.node(clusters.node[c]);
         if (n.count < 2) continue;  // one segment cannot hide itself: unmeasured
-        m_wanted[static_cast<size_t>(clusters.node[c])] = static_cast<int32_t>(c);
-        const auto mine = m_by_first.begin() + clusters.group_begin[c], end = m_by_first.begin() + clusters.group_begin[c + 1];
+        wanted[static_cast<size_t>(clusters.node[c])] = static_cast<int32_t>(c);
+        const auto mine = by_first.begin() + clusters.group_begin[c], end = by_first.begin() + clusters.group_begin[c + 1];
         for (int32_t g = clusters.group_begin[c]; g < clusters.group_begin[c + 1]; ++g)
-            m_by_first[static_cast<size_t>(g)] = {h.node(clusters.group_node[static_cast<size_t>(g)]).first, g};
+            by_first[static_cast<size_t>(g)] = {h.node(clusters.group_node[static_cast<size_t>(g)]).first, g};
         std::sort(mine, end);
         [[maybe_unused]] int32_t next = n.first;  // the groups, by first place, follow one another
         for (auto it = mine; it != end; ++it) {
@@ -334,36 +339,16 @@ EnvelopeMeasure::EnvelopeMeasure(const Hierarchy& h, const std::vector<uint8_t>&
             next = it->first + h.node(clusters.group_node[static_cast<size_t>(it->second)]).count;
         }
         FLATRAD_ASSERT(next == n.first + n.count, "a cluster's groups tile its places");
-        const auto lo = std::lower_bound(m_non_blockers.begin(), m_non_blockers.end(), n.first);
-        const auto hi = std::lower_bound(lo, m_non_blockers.end(), n.first + n.count);
-        m_nb_range[c] = {static_cast<int32_t>(lo - m_non_blockers.begin()), static_cast<int32_t>(hi - m_non_blockers.begin())};
+        const auto lo = std::lower_bound(non_blockers.begin(), non_blockers.end(), n.first);
+        const auto hi = std::lower_bound(lo, non_blockers.end(), n.first + n.count);
+        nb_range[c] = {static_cast<int32_t>(lo - non_blockers.begin()), static_cast<int32_t>(hi - non_blockers.begin())};
     }
-}
-
-void EnvelopeMeasure::run(int first_pass, int passes, int threads, EnvelopeShares& out) const {
-    FLATRAD_ASSERT(first_pass >= 0 && passes >= 1 && first_pass + passes <= half, "passes within the K/2 direction pairs");
-    const size_t C = m_clusters.node.size(), G = m_clusters.group_node.size(), bins = 2 * static_cast<size_t>(passes);
-    out.clusters = C;
-    out.groups = G;
-    out.first_pass = first_pass;
-    out.passes = passes;
-    // (Each pass writes its bins in full: DirectionPass::run. Grown only:
-    // a caller running a few passes at a time reuses the same pages.)
-    if (out.whole_by_bin.size() < C * bins) out.whole_by_bin.resize(C * bins);
-    if (out.group_by_bin.size() < G * bins) out.group_by_bin.resize(G * bins);
-    if (out.front_by_bin.size() < C * bins) out.front_by_bin.resize(C * bins);
-#pragma omp parallel num_threads(std::max(1, std::min(threads, passes)))
+#pragma omp parallel num_threads(std::max(1, std::min(threads, half)))
     {
-        DirectionPass pass(m_h, m_sides, m_clusters, m_wanted, m_non_blockers, m_nb_range, m_by_first, out);
+        DirectionPass pass(h, sides_at, clusters, wanted, non_blockers, nb_range, by_first, out);
 #pragma omp for schedule(dynamic, 1)
-        for (int k = first_pass; k < first_pass + passes; ++k) pass.run(k);
+        for (int k = 0; k < half; ++k) pass.run(k);
     }
-}
-
-EnvelopeShares cluster_visible_fractions(const Hierarchy& h, const std::vector<uint8_t>& sides_at,
-                                         const EnvelopeClusters& clusters, int threads) {
-    EnvelopeShares out;
-    EnvelopeMeasure(h, sides_at, clusters).run(0, half, threads, out);
     return out;
 }
 

@@ -1284,13 +1284,6 @@ void HierarchicalSolver::gather_from_children(size_t k) {
     }
 }
 
-// Self occlusion measures this many of the K/2 direction pairs at a time
-// (EnvelopeMeasure::run), a quarter of the shares' memory of all at once.
-// On the 10^6 forest (two threads, one run each, the same answers bit for
-// bit): the stage 5.87 s at 16 (all at once), 5.08 s at 4, 5.41 s at 2
-// (two passes a batch on two threads wait for the slower one).
-constexpr int pairs_at_once = 4;
-
 // Occlusion inside clusters (solver/self_occlusion.h). Per table cluster,
 // per direction bin: A, the share of its members' lobes seen from outside
 // it (visible_fraction's measure, for every cluster at once by merged
@@ -1367,12 +1360,11 @@ void HierarchicalSolver::self_occlusion(const std::vector<size_t>& level_start) 
         }
         asked.group_begin.push_back(static_cast<int32_t>(asked.group_node.size()));
     }
-    // The shares a few direction pairs at a time (pairs_at_once), each
-    // batch turned into faces and gammas before the next one reuses its
-    // columns: all K bins at once were 1 GB of doubles at 10^6 segments,
-    // pages this machine backs at about 2.5 s of system time a GB.
+    const EnvelopeShares shares = cluster_visible_fractions(m_hierarchy, sides_at, asked, m_threads);
+    FLATRAD_ASSERT(shares.groups == static_cast<size_t>(slots), "one group per slot");
+    if (std::all_of(shares.whole_by_bin.begin(), shares.whole_by_bin.end(), [](double a) { return a == 1.0; })) return;
     // (The shares are held bin after bin, the clusters in this order: each
-    // loop below reads a batch's runs in step.)
+    // loop below reads K runs in step.)
     // Each table's face: the mean depth of what it shows along each bin,
     // from its centre, within its radius (0 where it shows nothing).
     const auto& dirs = bin_directions();
@@ -1381,27 +1373,13 @@ void HierarchicalSolver::self_occlusion(const std::vector<size_t>& level_start) 
         measured[static_cast<size_t>(m_nodes[static_cast<size_t>(clusters[q])].table)] = static_cast<int32_t>(q);
     m_face.resize(static_cast<size_t>(m_tables_count) * K);  // (every row written below)
     m_gamma.resize(static_cast<size_t>(slots) * K);
-    const EnvelopeMeasure measure(m_hierarchy, sides_at, asked);
-    EnvelopeShares shares;
-    bool hides = false;  // some share below 1
-    constexpr int pairs = K / 2;
-    for (int first = 0; first < pairs; first += pairs_at_once) {
-        const int passes = std::min(pairs_at_once, pairs - first);
-        measure.run(first, passes, m_threads, shares);
-        FLATRAD_ASSERT(shares.groups == static_cast<size_t>(slots), "one group per slot");
-        const size_t held = 2 * static_cast<size_t>(passes) * shares.clusters;
-        hides = hides || std::any_of(shares.whole_by_bin.begin(), shares.whole_by_bin.begin() + static_cast<std::ptrdiff_t>(held),
-                                     [](double a) { return a != 1.0; });
-        int bins[2 * pairs];
-        int nb = 0;
-        for (int b = 0; b < K; ++b)
-            if (shares.holds(b)) bins[nb++] = b;
-#pragma omp parallel for num_threads(m_threads) schedule(static)
+#pragma omp parallel num_threads(m_threads)
+    {
+#pragma omp for schedule(static)
         for (size_t q = 0; q < clusters.size(); ++q) {
             const Node& n = m_nodes[static_cast<size_t>(clusters[q])];
             float* face = &m_face[static_cast<size_t>(n.table) * K];
-            for (int i = 0; i < nb; ++i) {
-                const int b = bins[i];
+            for (int b = 0; b < K; ++b) {
                 const double o = shares.front(q, b) - dot(n.center, dirs[static_cast<size_t>(b)]);
                 face[b] = static_cast<float>(std::isfinite(o) ? std::clamp(o, -n.radius, n.radius) : 0.0);
             }
@@ -1416,8 +1394,7 @@ void HierarchicalSolver::self_occlusion(const std::vector<size_t>& level_start) 
                 const size_t sl = static_cast<size_t>(slot[static_cast<size_t>(ch)]);
                 float* g = &m_gamma[sl * K];
                 const int32_t own = c.table >= 0 ? measured[static_cast<size_t>(c.table)] : -1;
-                for (int i = 0; i < nb; ++i) {
-                    const int b = bins[i];
+                for (int b = 0; b < K; ++b) {
                     const double seen = shares.group(sl, b);
                     if (c.table < 0) {
                         g[b] = static_cast<float>(seen);
@@ -1428,17 +1405,11 @@ void HierarchicalSolver::self_occlusion(const std::vector<size_t>& level_start) 
                 }
             }
         }
+        // The tables left unmeasured face their centre.
+#pragma omp for schedule(static)
+        for (size_t t = 0; t < measured.size(); ++t)
+            if (measured[t] < 0) std::fill_n(&m_face[t * K], K, 0.0f);
     }
-    if (!hides) {
-        // Nothing hides anything: no gammas, no faces (as if unmeasured).
-        m_face.clear();
-        m_gamma.clear();
-        return;
-    }
-    // The tables left unmeasured face their centre.
-#pragma omp parallel for num_threads(m_threads) schedule(static)
-    for (size_t t = 0; t < measured.size(); ++t)
-        if (measured[t] < 0) std::fill_n(&m_face[t * K], K, 0.0f);
     m_sensitivity_all = m_sensitivity;
     m_hidden_below.assign(static_cast<size_t>(m_tables_count), 0);
     m_gamma_slot = std::move(slot);

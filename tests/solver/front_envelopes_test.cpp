@@ -170,49 +170,6 @@ TEST_CASE("front envelopes: hundreds of sticks, some that cannot block, against 
     check_against_oracle(segs, sides, s, got);
 }
 
-TEST_CASE("front envelopes: a few direction pairs at a time give every bin's values exactly") {
-    // EnvelopeMeasure::run over batches of passes (as the hierarchical
-    // solver runs it, reusing one EnvelopeShares) against all passes at
-    // once: each pass is the same computation, so the same numbers bit for
-    // bit, whatever the batch and whatever an earlier batch left in the
-    // reused columns.
-    std::mt19937 rng(5);
-    const std::vector<Segment> segs = sticks(200, 0.08, rng);
-    std::vector<uint8_t> sides;
-    std::uniform_int_distribution<int> pick(0, 9);
-    for (size_t i = 0; i < segs.size(); ++i) {
-        const int r = pick(rng);
-        sides.push_back(static_cast<uint8_t>((r % 3 == 0 ? left_side | right_side : r % 3 == 1 ? left_side : right_side) |
-                                             (r == 9 ? 0 : blocks)));
-    }
-    const Setup s = every_cluster(segs, sides, 3);
-    const EnvelopeShares all = cluster_visible_fractions(s.h, s.sides_at, s.clusters, 2);
-    const EnvelopeMeasure measure(s.h, s.sides_at, s.clusters);
-    for (const int batch : {1, 3, 4, 16}) {
-        CAPTURE(batch);
-        EnvelopeShares part;
-        int seen_bins = 0;
-        for (int first = 0; first < K / 2; first += batch) {
-            const int passes = std::min(batch, K / 2 - first);
-            measure.run(first, passes, 2, part);
-            for (int k = 0; k < K; ++k) {
-                CAPTURE(k);
-                const bool held = (k % (K / 2)) >= first && (k % (K / 2)) < first + passes;
-                REQUIRE(part.holds(k) == held);
-                if (!held) continue;
-                ++seen_bins;
-                for (size_t c = 0; c < s.clusters.node.size(); ++c) {
-                    CHECK(part.whole(c, k) == all.whole(c, k));
-                    const double f = part.front(c, k), g = all.front(c, k);
-                    CHECK(((std::isnan(f) && std::isnan(g)) || f == g));
-                }
-                for (size_t g = 0; g < s.clusters.group_node.size(); ++g) CHECK(part.group(g, k) == all.group(g, k));
-            }
-        }
-        CHECK(seen_bins == K);  // every bin in exactly one batch
-    }
-}
-
 TEST_CASE("front envelopes: crossing segments split where they cross (closed form)") {
     // An X: the diagonals of the square [-1, 1]^2, both two-sided blockers.
     // Seen from far along +y, the one rising to the left is in front for x
