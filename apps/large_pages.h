@@ -21,8 +21,12 @@
 // loader runs after relocation and before any library's constructor,
 // mimalloc's included, so before the first allocation; elsewhere, first
 // thing in main().
+#include <cstdint>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
+#include <string>
+#include <system_error>
 
 #if FLATRAD_WITH_MIMALLOC
 #include <mimalloc.h>
@@ -74,6 +78,44 @@ inline void use_large_pages(char** envp) {
     if (!option_set_by_environment(envp, "MIMALLOC_EAGER_COMMIT_DELAY")) mi_option_set(mi_option_eager_commit_delay, 0);
 #else
     (void)envp;
+#endif
+}
+
+/// Scene files larger than this turn large pages off (large_pages_for_scene).
+inline constexpr std::uintmax_t large_pages_max_scene_bytes = std::uintmax_t{2} << 20;
+
+/// Large pages only for small scenes: for a scene file of more than
+/// large_pages_max_scene_bytes (some 20 000 segments on), the segments
+/// mapped from then on come in 4 KiB pages, unless the environment sets
+/// MIMALLOC_LARGE_OS_PAGES (whose word stands). The main thread's first
+/// segment, mapped before main(), keeps its large pages. The flatrad tool
+/// calls it right before reading each scene (cli/scene_warnings.h's
+/// set_before_scene_read). A path that is not a regular file: nothing.
+///
+/// Why: on this machine (a virtual machine whose guest reports freed memory
+/// to its host, "Free page reporting enabled" at boot) a 2 MiB page costs
+/// about twice the system time per byte of 4 KiB pages when first touched
+/// (a freed huge page is a whole block the guest hands back, backed afresh
+/// when used again), and the large footprints of large scenes pay it over
+/// and over; small ones touch a few segments and keep the gain of few
+/// faults. `flatrad solve`, interleaved runs with MIMALLOC_LARGE_OS_PAGES=0
+/// against large pages throughout (medians; the forests of `scripts/
+/// make-scene N --seed 1 --density 30` at eps 10, the round room of
+/// `--round` at eps 3e-3): 10^3 segments (0.1 MB file, eps 12) 38.3 against
+/// 35.3 ms, 10^4 (1 MB) 0.473 against 0.458 s; 3 x 10^4 (3 MB) 1.40
+/// against 1.55 s; 10^5 (10 MB) 4.15 against 4.28 s, 4.68 against 4.92 s
+/// from start to result; the round room of 10^6 (33 MB) 4.22 against 5.33
+/// s (sys 1.75 against 3.4 s); reading the 10^6 forest's 107 MB file 3.7
+/// against 6.1 s.
+inline void large_pages_for_scene(const std::string& path) {
+#if FLATRAD_WITH_MIMALLOC
+    if (std::getenv("MIMALLOC_LARGE_OS_PAGES") || std::getenv("mimalloc_large_os_pages")) return;
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(path, ec)) return;
+    const std::uintmax_t size = std::filesystem::file_size(path, ec);
+    if (!ec && size > large_pages_max_scene_bytes) mi_option_disable(mi_option_large_os_pages);
+#else
+    (void)path;
 #endif
 }
 

@@ -10,8 +10,10 @@
 #include <cstdlib>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "large_pages.h"
+#include "support/cli_run.h"
 
 FLATRAD_USE_LARGE_PAGES  // as apps/flatrad.cpp does
 
@@ -42,6 +44,31 @@ TEST_CASE("the environment's setting of large pages is found in envp") {
     CHECK(flatrad::option_set_by_environment(delay_lower, "MIMALLOC_EAGER_COMMIT_DELAY"));
     CHECK_FALSE(flatrad::option_set_by_environment(other, "MIMALLOC_EAGER_COMMIT_DELAY"));
     CHECK_FALSE(flatrad::option_set_by_environment(upper, "MIMALLOC_EAGER_COMMIT_DELAY"));
+}
+
+TEST_CASE("large pages are turned off for a scene file above the limit, and only then") {
+    // large_pages_for_scene: a file of more than large_pages_max_scene_bytes
+    // turns mimalloc's option off for what is mapped next; one of exactly
+    // that size, a path that is no file, or a directory leave it; the
+    // environment's setting always stands.
+    const bool env = std::getenv("MIMALLOC_LARGE_OS_PAGES") || std::getenv("mimalloc_large_os_pages");
+    const bool before = mi_option_is_enabled(mi_option_large_os_pages);
+    flatrad::test::TempDir tmp;
+    const std::string at_limit = tmp.file("at_limit.json", std::string(flatrad::large_pages_max_scene_bytes, ' '));
+    const std::string above = tmp.file("above.json", std::string(flatrad::large_pages_max_scene_bytes + 1, ' '));
+    flatrad::large_pages_for_scene(at_limit);
+    flatrad::large_pages_for_scene(tmp.path("missing.json"));
+    flatrad::large_pages_for_scene(tmp.dir().string());
+    CHECK(mi_option_is_enabled(mi_option_large_os_pages) == before);
+    flatrad::large_pages_for_scene(above);
+    if (env)
+        CHECK(mi_option_is_enabled(mi_option_large_os_pages) == before);
+    else
+        CHECK_FALSE(mi_option_is_enabled(mi_option_large_os_pages));
+    // Allocation goes on as before (from 4 KiB pages).
+    std::vector<double> big(size_t{1} << 23, 1.0);  // 64 MiB: new segments
+    CHECK(mi_is_in_heap_region(big.data()));
+    CHECK(big.back() == 1.0);
 }
 
 TEST_CASE("the programs' operator new and malloc are mimalloc's, with large OS pages from before main") {
