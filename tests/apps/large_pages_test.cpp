@@ -52,7 +52,9 @@ TEST_CASE("large pages are turned off for a scene file above the limit, and only
     // that size, a path that is no file, or a directory leave it; the
     // environment's setting always stands.
     const bool env = std::getenv("MIMALLOC_LARGE_OS_PAGES") || std::getenv("mimalloc_large_os_pages");
+    flatrad::use_large_pages_in_main();  // (where .preinit_array did not set them)
     const bool before = mi_option_is_enabled(mi_option_large_os_pages);
+    if (!env) REQUIRE(before);  // on, so that turning them off is seen
     flatrad::test::TempDir tmp;
     const std::string at_limit = tmp.file("at_limit.json", std::string(flatrad::large_pages_max_scene_bytes, ' '));
     const std::string above = tmp.file("above.json", std::string(flatrad::large_pages_max_scene_bytes + 1, ' '));
