@@ -81,6 +81,12 @@ inline void use_large_pages(char** envp) {
 #endif
 }
 
+/// Whether this process's environment sets mimalloc's large-pages option
+/// (either spelling), read with getenv (from main() on).
+inline bool large_pages_set_in_environment() {
+    return std::getenv("MIMALLOC_LARGE_OS_PAGES") || std::getenv("mimalloc_large_os_pages");
+}
+
 /// Scene files larger than this turn large pages off (large_pages_for_scene).
 inline constexpr std::uintmax_t large_pages_max_scene_bytes = std::uintmax_t{2} << 20;
 
@@ -109,10 +115,9 @@ inline constexpr std::uintmax_t large_pages_max_scene_bytes = std::uintmax_t{2} 
 /// against 6.1 s.
 inline void large_pages_for_scene(const std::string& path) {
 #if FLATRAD_WITH_MIMALLOC
-    if (std::getenv("MIMALLOC_LARGE_OS_PAGES") || std::getenv("mimalloc_large_os_pages")) return;
+    if (large_pages_set_in_environment()) return;
     std::error_code ec;
-    if (!std::filesystem::is_regular_file(path, ec)) return;
-    const std::uintmax_t size = std::filesystem::file_size(path, ec);
+    const std::uintmax_t size = std::filesystem::file_size(path, ec);  // (an error for what is not a regular file)
     if (!ec && size > large_pages_max_scene_bytes) mi_option_disable(mi_option_large_os_pages);
 #else
     (void)path;
@@ -128,8 +133,7 @@ inline void use_large_pages_preinit(int, char**, char** envp) { use_large_pages(
 /// segment mapped from then on; elsewhere nothing (it is set already).
 inline void use_large_pages_in_main() {
 #if !(defined(__ELF__) && defined(__linux__)) && FLATRAD_WITH_MIMALLOC
-    if (!std::getenv("MIMALLOC_LARGE_OS_PAGES") && !std::getenv("mimalloc_large_os_pages"))
-        mi_option_enable(mi_option_large_os_pages);
+    if (!large_pages_set_in_environment()) mi_option_enable(mi_option_large_os_pages);
     if (!std::getenv("MIMALLOC_EAGER_COMMIT_DELAY") && !std::getenv("mimalloc_eager_commit_delay"))
         mi_option_set(mi_option_eager_commit_delay, 0);
 #endif
