@@ -97,7 +97,7 @@ TEST_CASE("compare: JSON fields, finite errors, hierarchical error falls with ep
     fs::remove(scene);
 }
 
-TEST_CASE("compare: -o writes the file; bad flags give status 2") {
+TEST_CASE("compare: -o writes the file, bad flags give status 2") {
     const std::string scene = write_scene(pillar_box);
     const fs::path out = fs::temp_directory_path() / ("flatrad_compare_out_" + std::to_string(::getpid()) + ".json");
     const Run r = run({"compare", scene, "-q", "--eps", "0.05", "--subdivide", "8", "--max-elements", "600", "-o",

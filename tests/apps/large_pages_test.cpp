@@ -55,6 +55,12 @@ TEST_CASE("large pages are turned off for a scene file above the limit, and only
     flatrad::use_large_pages_in_main();  // (where .preinit_array did not set them)
     const bool before = mi_option_is_enabled(mi_option_large_os_pages);
     if (!env) REQUIRE(before);  // on, so that turning them off is seen
+    // Put back at the end, whatever happens: the next case checks that the
+    // option is on (each case must pass run alone or in one run of all).
+    struct Restore {
+        bool on;
+        ~Restore() { mi_option_set_enabled(mi_option_large_os_pages, on); }
+    } restore{before};
     flatrad::test::TempDir tmp;
     const std::string at_limit = tmp.file("at_limit.json", std::string(flatrad::large_pages_max_scene_bytes, ' '));
     const std::string above = tmp.file("above.json", std::string(flatrad::large_pages_max_scene_bytes + 1, ' '));

@@ -79,7 +79,7 @@ TEST_CASE("solve --svg: one line per element, the scene's name, both methods") {
     fs::remove_all(dir);
 }
 
-TEST_CASE("solve --svg: three channels in true color, no legend; one channel has a legend") {
+TEST_CASE("solve --svg: three channels in true color, no legend, one channel has a legend") {
     const fs::path dir = temp_dir();
     const fs::path svg = dir / "room.svg";
     REQUIRE(run({"solve", std::string(FLATRAD_DATA_DIR) + "/furnished_room.json", "-q", "-o",

@@ -32,7 +32,7 @@ std::vector<fs::path> data_scenes() {
 
 }  // namespace
 
-TEST_CASE("data/*.json: every scene loads; small ones solve exactly with energy balanced") {
+TEST_CASE("data/*.json: every scene loads, small ones solve exactly with energy balanced") {
     const std::vector<fs::path> files = data_scenes();
     REQUIRE(files.size() >= 4);
     for (const fs::path& file : files) {

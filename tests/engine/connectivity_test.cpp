@@ -228,7 +228,7 @@ TEST_CASE("escape_free: a closed room's sides") {
     CHECK(scene_connectivity(right).loops.size() == 1);
 }
 
-TEST_CASE("escape_free: objects inside a room on all their sides; outside or crossing, not") {
+TEST_CASE("escape_free: objects inside a room on all their sides, outside or crossing, not") {
     const Scene scene = scene_of({
         poly("room", square4, "in", true),
         circle("pillar", {1, 1}, 0.5, 24, "out"),

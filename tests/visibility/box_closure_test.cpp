@@ -121,7 +121,7 @@ struct ProofForest {
 
 }  // namespace
 
-TEST_CASE("box closure: the sides lie outside the box, each lit outward; the margin is scale-free") {
+TEST_CASE("box closure: the sides lie outside the box, each lit outward, the margin is scale-free") {
     Box b;
     b.add(Vec2{1, 2});
     b.add(Vec2{4, 3});
@@ -226,7 +226,7 @@ TEST_CASE("box closure: a box shown closed from a segment is closed to every seg
     CHECK(named >= 5);        // failed proofs that named their pair (others found no facing side)
 }
 
-TEST_CASE("box closure: two boxes shown closed are closed between any segments inside them; none when they meet") {
+TEST_CASE("box closure: two boxes shown closed are closed between any segments inside them, none when they meet") {
     const std::vector<Segment> segs = forest(80.0, 3, false);
     const Hierarchy h(segs, 1);
     const ClusterTables tables(h);

@@ -61,7 +61,7 @@ int leaf_of(const Hierarchy& h, int segment) {
 
 }  // namespace
 
-TEST_CASE("closure screen: faces the segment at the asked depth and width; none where it would not lie in front") {
+TEST_CASE("closure screen: faces the segment at the asked depth and width, none where it would not lie in front") {
     const Segment a{{0, 0}, {1, 0}};  // lit upwards
     const auto t = closure_screen(a, {0.5, 10}, 5, 1);
     REQUIRE(t.has_value());
@@ -76,7 +76,13 @@ TEST_CASE("closure screen: faces the segment at the asked depth and width; none 
     CHECK(distance(tilted->midpoint(), Vec2{2, 2}) == doctest::Approx(0).epsilon(1e-12));
     CHECK_FALSE(closure_screen(a, {0.5, -10}, 5, 1).has_value());   // behind a
     CHECK_FALSE(closure_screen(a, {100, 0.1}, 5, 5).has_value());   // along a: half of it behind a's line
-    CHECK_FALSE(closure_screen(a, {0.5, 10}, 0.2, 1).has_value());  // a's ends beyond it (a reaches past)
+    // Shallow and wider than a, straight ahead: a lies wholly in front of
+    // it and it wholly on a's lit side, so it stands.
+    CHECK(closure_screen(a, {0.5, 10}, 0.2, 1).has_value());
+    // Tilted toward (10, 1) at depth 0.2: the screen (ends near (0.698,
+    // 0.031) and (0.700, 0.011)) is on a's lit side, but a's end (1, 0) is
+    // beyond its line (a reaches past it).
+    CHECK_FALSE(closure_screen(a, {10, 1}, 0.2, 0.01).has_value());
     CHECK_FALSE(closure_screen(a, {0.5, 0}, 5, 1).has_value());     // toward a's own midpoint
     CHECK_FALSE(closure_screen(a, {0.5, 10}, 0, 1).has_value());
     CHECK_FALSE(closure_screen(a, {0.5, 10}, 5, 0).has_value());
@@ -135,7 +141,7 @@ TEST_CASE("closure screen: covers a region only if every sampled line from the s
     CHECK(refused_with_a_miss >= 200);
 }
 
-TEST_CASE("closure screen: a region on the screen's line, or a segment reaching it, is never covered; scale-free") {
+TEST_CASE("closure screen: a region on the screen's line, or a segment reaching it, is never covered, scale-free") {
     const Segment a{{0, 0}, {1, 0}};
     const auto t = closure_screen(a, {0.5, 10}, 5, 1);  // y = 5, x in [-0.5, 1.5]
     REQUIRE(t.has_value());
