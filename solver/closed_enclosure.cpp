@@ -39,7 +39,12 @@ void refuse_closed_white(const Scene& scene, const std::vector<int>& patches, in
         const std::string name = "'" + scene.surfaces[static_cast<size_t>(scene.patches[static_cast<size_t>(p)].surface)].name + "'";
         if (names.find(name) == std::string::npos) names += (names.empty() ? "" : ", ") + name;
     }
-    throw InputError(scene.file, "",
+    // The path names the reflectance at fault: that of the first patch's
+    // material (every patch of the set has reflectance 1 in `channel`).
+    const int material = patches.empty() ? -1 : scene.patches[static_cast<size_t>(patches.front())].material;
+    const std::string path =
+        material >= 0 ? "materials." + scene.materials[static_cast<size_t>(material)].name + ".reflectance" : std::string{};
+    throw InputError(scene.file, path,
                      fmt::format("no unique solution: {} enclose(s) light with reflectance 1{} and "
                                  "nothing absorbs it; lower a reflectance below 1",
                                  names, scene.channels > 1 ? fmt::format(" in channel {}", channel) : std::string{}));

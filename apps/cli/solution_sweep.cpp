@@ -143,6 +143,7 @@ SolutionSweep run_solution_sweep(const Scene& scene, const SolutionSweepOptions&
                                                             options.eps.size(), r + 1, sweep.repeat));
             solution = solve_hierarchical(scene, h);
             times.push_back(solution.stats.time_s);
+            if (i == 0 && r == 0 && !options.header.empty()) say(options.header);
         }
         SolutionSweepRow row;
         row.eps = solution.eps;
@@ -335,9 +336,8 @@ int run_solution_sweep_command(const SweepArgs& args, std::ostream& out, std::os
     check_reference_cap(scene, o.reference.max_elements);
 
     if (!args.quiet)
-        err << fmt::format("sweep: {}, {} eps from {:g} to {:g}, median of {} run{}\n", scene_label(scene),
-                           o.eps.size(), o.eps.front(), o.eps.back(), o.repeat, o.repeat == 1 ? "" : "s")
-            << std::flush;
+        o.header = fmt::format("sweep: {}, {} eps from {:g} to {:g}, median of {} run{}", scene_label(scene),
+                               o.eps.size(), o.eps.front(), o.eps.back(), o.repeat, o.repeat == 1 ? "" : "s");
     ProgressLine progress(err, !args.quiet && is_terminal_stderr(err));
     const SolutionSweep sweep = run_solution_sweep(scene, o, args.quiet ? nullptr : &err, &progress);
     progress.clear();

@@ -372,7 +372,7 @@ CLI::App* add_sweep_command(CLI::App& app, SweepArgs& a) {
                                 "included (0 <= LO <= HI, 1 <= N <= {}; N = 1 runs LO alone); default {}. "
                                 "Whole-solution sweep: a list E1,E2,..., or A:B:N (linear) or A:B:Nlog "
                                 "(log-spaced) from A to B, both included, every value > 0, "
-                                "1 <= N <= {}; default {} (7 values from 0.1 down to 1e-4).",
+                                "1 <= N <= {}; default {} (9 values from 0.1 down to 1e-5).",
                                 max_sweep_points, default_form_factor_sweep_eps, max_solution_sweep_points,
                                 default_solution_sweep_eps))
         ->type_name("SPEC");

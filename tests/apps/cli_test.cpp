@@ -171,6 +171,33 @@ TEST_CASE("cli: bad scene files give status 2 and one line naming file and path"
             CHECK(r.out.empty());
         }
     }
+    SUBCASE("a closed room of reflectance 1 that nothing absorbs: no unique solution") {
+        // Found by the solvers, not the reader: every command that solves
+        // refuses it with the one line, the path of the reflectance at
+        // fault, and no output (sweep says nothing before it either).
+        const std::string white = tmp.file("white.json", R"({
+          "flatrad": 1,
+          "materials": { "w": { "reflectance": 1, "emission": 1 } },
+          "surfaces": [ { "name": "room", "material": "w", "points": [[0, 0], [4, 0], [4, 3], [0, 3]],
+                          "closed": true, "side": "in" } ]
+        })");
+        const std::string out = tmp.path("out.json");
+        const std::vector<std::vector<std::string>> commands = {
+            {"solve", white, "-o", out},
+            {"solve", white, "--method", "exact", "-o", out},
+            {"compare", white, "-o", out},
+            {"sweep", white, "--eps", "0.1", "--repeat", "1", "-o", out}};
+        for (const auto& args : commands) {
+            CAPTURE(args[0]);
+            CAPTURE(args.size());
+            const Run r = run(args);
+            CHECK(r.status == 2);
+            CHECK(is_one_error_line(r.err));
+            CHECK(r.err.rfind("error: " + white + ": materials.w.reflectance: no unique solution", 0) == 0);
+            CHECK(r.out.empty());
+            CHECK_FALSE(std::filesystem::exists(out));
+        }
+    }
 }
 
 TEST_CASE("cli: a misspelt key is said on stderr, and the scene solved as written") {

@@ -279,10 +279,10 @@ TEST_CASE("parse_eps_list: lists, linear and log ranges, in the order written") 
     // Log-spaced: whole decades exactly, the rest snapped to 15 digits.
     CHECK(parse_eps_list("1e-1:1e-4:4log") == std::vector<double>{0.1, 0.01, 0.001, 0.0001});
     const std::vector<double> d = parse_eps_list(flatrad::default_solution_sweep_eps);
-    REQUIRE(d.size() == 7);
+    REQUIRE(d.size() == 9);
     CHECK(d.front() == 0.1);
     CHECK(d[2] == 0.01);
-    CHECK(d.back() == 1e-4);
+    CHECK(d.back() == 1e-5);
     CHECK(d[1] == doctest::Approx(std::sqrt(0.1 * 0.01)).epsilon(1e-14));  // geometric middle
     CHECK(parse_eps_list("0.5:0.5:1log") == std::vector<double>{0.5});
     CHECK(parse_eps_list("1:2:1000").size() == 1000);
