@@ -20,9 +20,12 @@ namespace flatrad {
 
 namespace {
 
-void check_tolerance(const std::optional<double>& value, const char* flag) {
-    if (value && !(std::isfinite(*value) && *value >= 0))
-        throw UsageError(fmt::format("{}: expected a finite number >= 0, got {}", flag, *value));
+// `positive`: 0 refused too, and the message says so (one rule per flag,
+// whatever the value: -1 and 0 get the same bound).
+void check_tolerance(const std::optional<double>& value, const char* flag, bool positive = false) {
+    if (value && !(std::isfinite(*value) && (positive ? *value > 0 : *value >= 0)))
+        throw UsageError(fmt::format("{}: expected a finite number {} 0{}, got {}", flag, positive ? ">" : ">=",
+                                     positive ? " (--method hierarchical; 0 would refine forever)" : "", *value));
 }
 
 void check_arguments(const SolveArgs& args) {
@@ -33,10 +36,8 @@ void check_arguments(const SolveArgs& args) {
     if (args.threads < 0)
         throw UsageError(fmt::format("--threads: expected an integer >= 0 (0: all cores), got {}",
                                      args.threads));
-    check_tolerance(args.eps, "--eps");
+    check_tolerance(args.eps, "--eps", args.method == "hierarchical");
     check_tolerance(args.vis_eps, "--vis-eps");
-    if (args.method == "hierarchical" && args.eps && *args.eps == 0)
-        throw UsageError("--eps: --method hierarchical needs a tolerance > 0 (0 would refine forever)");
     if (!args.output.empty()) check_output_path(args.output, "-o");
     if (!args.svg.empty()) check_output_path(args.svg, "--svg");
 }

@@ -130,9 +130,15 @@ TEST_CASE("cli: solve --method hierarchical runs and records its tolerances") {
     CHECK(result["patches"].size() > 0);
     CHECK(result["stats"]["elements"].get<long>() >= static_cast<long>(result["patches"].size()));
 
-    const Run zero = run({"solve", scene, "--method", "hierarchical", "--eps", "0"});
-    CHECK(zero.status == 2);
-    CHECK(is_one_error_line(zero.err));
+    // 0 and -1 refused alike, with the bound that holds (> 0, not >= 0).
+    for (const char* bad : {"0", "-1"}) {
+        const Run r = run({"solve", scene, "--method", "hierarchical", "--eps", bad});
+        CHECK(r.status == 2);
+        CHECK(is_one_error_line(r.err));
+        CHECK(r.err.find("--eps: expected a finite number > 0") != std::string::npos);
+    }
+    // The exact method ignores --eps: 0 is no error there.
+    CHECK(run({"solve", scene, "--method", "exact", "--eps", "0", "--quiet"}).status == 0);
 }
 
 TEST_CASE("cli: --svg and compare have landed (no more \"not available yet\")") {
