@@ -635,6 +635,9 @@ public:
           m_obox(oriented_boxes(m_hierarchy)) {
         m_threads = o.threads > 0 ? o.threads : omp_get_max_threads();
         m_vis_eps = o.vis_eps >= 0 ? o.vis_eps : o.eps / 10;
+        // A visibility tolerance of 0 asks for exact visibility on every
+        // link: none carries the density's estimate (see the header).
+        if (m_vis_eps == 0) m_opt.defer_visibility = false;
         // Walls on the scene's hull block nothing (engine/convex_scene.h):
         // visibility skips them; with no blocker at all it is never asked.
         const std::vector<char>& blockers = m_blockers;

@@ -132,7 +132,9 @@
 ///    per unit of depth, MultiscaleVisibility::layers_per_depth), with a
 ///    cluster's box counting the blockers in it that are not its members. A
 ///    sender too dim for any transmittance to matter is never queried;
-///    later rounds ask again against the new solution.
+///    later rounds ask again against the new solution. With vis_eps 0
+///    (exact visibility asked for) nothing is deferred: every link that
+///    survives its geometry asks the visibility module.
 ///    stats.unqueried_links counts the links the final solve carried so.
 ///  - Closure screens (visibility/closure_screen.h): in a dense scene a
 ///    bright element's links to clusters many layers of shadow away are
@@ -209,7 +211,7 @@ namespace flatrad {
 
 struct HierarchicalOptions {
     double eps = 3e-3;       ///< relative refinement tolerance (see above), > 0; 3e-3: 0.06-0.2% L2 error on the data scenes, 0.1: 0.4-1.2%
-    double vis_eps = -1;     ///< absolute tolerance on F for visibility; < 0: eps / 10
+    double vis_eps = -1;     ///< absolute tolerance on F for visibility; < 0: eps / 10; 0: exact, no link deferred
     int max_depth = 12;      ///< deepest element level (a patch is level 0)
     int max_passes = 16;     ///< refine-solve rounds at most (from the emission alone, light takes a round or two per bounce that matters)
     int threads = 0;         ///< 0: all cores

@@ -91,7 +91,9 @@ void add_solve(CLI::App& app, Commands& c) {
                       ->type_name("E");
     c.solve_vis_eps = cmd->add_option("--vis-eps", c.vis_eps_value,
                                       "Visibility tolerance of the hierarchical solver (the "
-                                      "paper's epsilon for Gamma), >= 0. Ignored by --method exact.")
+                                      "paper's epsilon for Gamma), >= 0; default eps / 10. 0: exact "
+                                      "visibility on every occluded link (none carries the density's "
+                                      "estimate). Ignored by --method exact.")
                           ->type_name("E");
     cmd->add_option("--subdivide", a.subdivide,
                     "K >= 1: elements per patch for --method exact. Its three dense matrices need "

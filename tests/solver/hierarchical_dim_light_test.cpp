@@ -21,6 +21,7 @@
 #include "solver/hierarchical_solver.h"
 #include "support/forest_scene.h"
 #include "support/relative_l2.h"
+#include "support/same_solution.h"
 
 using namespace flatrad;
 using flatrad::test::forest_json;
@@ -216,4 +217,22 @@ TEST_CASE("hierarchical dim light: faint overlapping neighbours are not split, a
         // What it is for: fewer links.
         CHECK(h.stats.links < ho.stats.links);
     }
+}
+
+TEST_CASE("hierarchical dim light: vis_eps 0 asks exact visibility of every link, none deferred") {
+    // --vis-eps 0 is a request for exact visibility: no link may carry the
+    // density's estimate then. The same solve as with deferral switched off
+    // by hand, bit for bit; the default tolerance defers some (so that the
+    // first check can fail).
+    const Scene scene = parse_scene(forest_json(300, 3.2, 3.2, 7), "forest300.json");
+    HierarchicalOptions o;
+    o.eps = 0.5;
+    const Solution deferred = solve_hierarchical(scene, o);
+    CHECK(deferred.stats.unqueried_links > 0);
+    o.vis_eps = 0;
+    const Solution exact_vis = solve_hierarchical(scene, o);
+    CHECK(exact_vis.stats.unqueried_links == 0);
+    CHECK(exact_vis.vis_eps == 0);
+    o.defer_visibility = false;
+    flatrad::test::check_same(exact_vis, solve_hierarchical(scene, o));
 }
