@@ -821,6 +821,7 @@ private:
     void solve(double tolerance = gmres_tolerance);
     void row_sums();
     std::vector<double> leaf_guess() const;
+    std::vector<char> dark_patches() const;
     std::vector<double> landed_fraction() const;
     void push_down(TableArray& tables, const std::vector<double>& own, double lobe_scale,
                    std::vector<double>& above, const Part* part = nullptr) const;
@@ -2570,14 +2571,42 @@ std::vector<double> HierarchicalSolver::leaf_guess() const {
         ab.add(m_nodes[static_cast<size_t>(node)].length * a);
     }
     const double bbar = ab.value() > 0 ? em.value() / ab.value() : 0;
+    const std::vector<char> dark = dark_patches();
     std::vector<double> g(static_cast<size_t>(m_element_leaves));
     for (size_t i = 0; i < g.size(); ++i) {
         const int node = m_leaves[i];
+        const int patch = m_nodes[static_cast<size_t>(node)].patch;
+        const bool in_dark_room = static_cast<size_t>(patch) < dark.size() && dark[static_cast<size_t>(patch)];
         double b = 0;
-        for (int c = 0; c < m_C; ++c) b = std::max(b, emission(node, c) + rho(node, c) * bbar);
+        for (int c = 0; c < m_C; ++c) b = std::max(b, emission(node, c) + (in_dark_room ? 0.0 : rho(node, c) * bbar));
         g[i] = b;
     }
     return g;
+}
+
+// Per scene patch, whether its room (solver/rooms.h) holds no emitting
+// side: light cannot cross a room's walls, so no light reaches it. Where an
+// emitting side's room is unknown, any room may hold it: none is dark.
+std::vector<char> HierarchicalSolver::dark_patches() const {
+    const size_t P = m_scene.patches.size();
+    std::vector<char> dark;
+    if (!m_opt.dark_rooms_start_dark || m_side_room.size() != 2 * m_scene.segments.size()) return dark;
+    auto side_of = [&](const Patch& p) { return 2 * static_cast<size_t>(p.segment) + (p.lit_left ? 0 : 1); };
+    std::vector<int> lit_rooms;
+    for (const Patch& p : m_scene.patches) {
+        const Material& m = m_scene.materials[static_cast<size_t>(p.material)];
+        if (std::none_of(m.emission.begin(), m.emission.end(), [](double e) { return e > 0; })) continue;
+        const int room = m_side_room[side_of(p)];
+        if (room == room_unknown) return dark;
+        lit_rooms.push_back(room);
+    }
+    std::sort(lit_rooms.begin(), lit_rooms.end());
+    dark.assign(P, 0);
+    for (size_t q = 0; q < P; ++q) {
+        const int room = m_side_room[side_of(m_scene.patches[q])];
+        dark[q] = room != room_unknown && !std::binary_search(lit_rooms.begin(), lit_rooms.end(), room);
+    }
+    return dark;
 }
 
 // Leaf values for the refinement's error estimates. A side that sends

@@ -120,7 +120,10 @@
 ///    radiosity that 18 000 of its 20 000 patches end with, and refinement
 ///    only splits. (eps_abs of that first round is the closed room's:
 ///    the emission alone would make it too fine near the emitters.)
-///    stats.first_round says which start was taken.
+///    stats.first_round says which start was taken. Either way a room
+///    (solver/rooms.h) that holds no emitting side starts at 0: no light
+///    can reach it, and its links are not refined for light it will never
+///    get (a sealed box in a lit room was cut into 10 elements a side).
 ///  - Deferred visibility: a link's visibility is asked only when the link
 ///    survives its geometry and its error with the transmittance unknown
 ///    (an estimate tau_est, any truth in [0, 1]: a bound of max(tau_est,
@@ -270,6 +273,10 @@ struct HierarchicalOptions {
     /// (stats.setups_kept); off: every solve sets up anew (for tests: the
     /// oracle, bit for bit).
     bool keep_unchanged_setup = true;
+    /// Rooms holding no emitting side start the first round at 0 (see "The
+    /// first round" above); off: at the closed room's guess like every
+    /// other (for tests: the oracle).
+    bool dark_rooms_start_dark = true;
     /// The links r <- s and s <- r between two elements share one
     /// visibility query (the shorter element its receiver, the other way's
     /// answer by reciprocity, L_r F_rs = L_s F_sr); off: each link asks its

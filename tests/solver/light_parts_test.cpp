@@ -9,7 +9,9 @@
 #include <string>
 
 #include "engine/scene.h"
+#include "solver/exact_solver.h"
 #include "solver/hierarchical_solver.h"
+#include "support/relative_l2.h"
 
 using namespace flatrad;
 
@@ -129,4 +131,38 @@ TEST_CASE("hierarchical solver: a convex room skips the light-flow check, with w
                 CHECK(a.patches[p].radiosity == b.patches[p].radiosity);
         }
     }
+}
+
+TEST_CASE("hierarchical solver: a room without an emitter starts dark and is not refined") {
+    // Room c of three_rooms holds no emitting side, so no light can reach
+    // it (solver/rooms.h): the first round starts it at 0 and splits none of
+    // its links. The oracle (dark_rooms_start_dark off) starts it at the
+    // closed room's guess and cuts its sides into elements, all of them 0
+    // after the solve. Both against the exact solver: the lit rooms' error
+    // is the oracle's, as two solutions of one tolerance are (at most 1.25x
+    // plus 1e-5, as hierarchical_dim_light_test.cpp allows for its own
+    // oracle).
+    constexpr double same_error_ratio = 1.25, same_error_floor = 1e-5;
+    const Scene scene = parse_scene(three_rooms(0.3), "three.json");
+    HierarchicalOptions on, off;
+    on.eps = off.eps = 1e-3;
+    off.dark_rooms_start_dark = false;
+    const Solution a = solve_hierarchical(scene, on);
+    const Solution o = solve_hierarchical(scene, off);
+    const Solution exact = solve_exact(scene, {8, 0});
+    size_t dark = 0, oracle_elements = 0;
+    for (size_t p = 0; p < scene.patches.size(); ++p) {
+        if (scene.surfaces[static_cast<size_t>(scene.patches[p].surface)].name != "room c") continue;
+        ++dark;
+        CHECK(a.patches[p].elements.size() == 1);
+        oracle_elements += o.patches[p].elements.size();
+        for (double b : a.patches[p].radiosity) CHECK(b == 0);
+    }
+    REQUIRE(dark == 4);
+    CHECK(oracle_elements > dark);  // the oracle does cut them (so that the check above can fail)
+    CHECK(a.stats.elements < o.stats.elements);
+    const double err = flatrad::test::relative_l2(scene, a, exact), oracle = flatrad::test::relative_l2(scene, o, exact);
+    CAPTURE(err);
+    CAPTURE(oracle);
+    CHECK(err <= same_error_ratio * oracle + same_error_floor);
 }
