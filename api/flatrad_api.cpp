@@ -260,6 +260,7 @@ Result solve(const Scene& api_scene, const SolveOptions& options) {
     r.elements = solution.stats.elements;
     r.links = solution.stats.links;
     r.residual = solution.stats.residual;
+    r.refined_to_eps = solution.stats.refined_to_eps;
     r.threads = solution.stats.threads;
     return r;
 }

@@ -1001,6 +1001,7 @@ private:
     double m_ff_time = 0, m_solve_time = 0, m_residual = 0;
     long m_iterations = 0;
     int m_passes = 0;  // refine-solve rounds
+    bool m_refined_to_eps = false;  // a round split nothing (run; stats.refined_to_eps)
     bool m_solved = false;  // m_B holds a solution (the next Krylov run starts from it)
     // The operator may differ from the last solve's: a link was made,
     // split, dropped or given its visibility since (refine). When not, the
@@ -3645,7 +3646,10 @@ Solution HierarchicalSolver::run() {
                 changed = refine(bmax);
             }
             end_phase(fmt::format("refine {}", pass + 1));
-            if (!changed) break;
+            if (!changed) {
+                m_refined_to_eps = true;
+                break;
+            }
             last_tolerance = pass + 1 < m_opt.max_passes ? loose : gmres_tolerance;
             solve(last_tolerance);
             end_phase(fmt::format("solve {}", pass + 1));
@@ -3659,6 +3663,7 @@ Solution HierarchicalSolver::run() {
         }
     } else {
         collect_leaves();  // nothing emits: B = 0 everywhere, no link needed
+        m_refined_to_eps = true;
         m_left_out = static_cast<long>(m_scene.patches.size());
         m_B.assign(static_cast<size_t>(m_C), std::vector<double>(m_nodes.size(), 0.0));
         m_H = m_B;
@@ -3749,6 +3754,7 @@ Solution HierarchicalSolver::run() {
     sol.stats.independent_parts = m_part_count;
     sol.stats.iterations = m_iterations;
     sol.stats.passes = m_passes;
+    sol.stats.refined_to_eps = m_refined_to_eps;
     sol.stats.setups_kept = m_setups_kept;
     sol.stats.emission_first = m_emission_first && m_passes > 0;
     sol.stats.residual = m_residual;

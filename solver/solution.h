@@ -64,6 +64,11 @@ struct SolveStats {
     long sampled_tables = 0;    ///< hierarchical: of those, the ones whose samples the final solve kept (the rest: linear part only)
     long unqueried_links = 0;   ///< hierarchical: links whose shaft may hold blockers, carried at the density's estimate of their transmittance, their visibility never asked (within eps whatever it is; part of `links`)
     long passes = 0;            ///< hierarchical: refine-solve rounds
+    /// hierarchical: the last refinement round split no link, so every link
+    /// is within eps; false when HierarchicalOptions::max_passes rounds ran
+    /// out with links still splitting (the error may exceed what eps
+    /// promises). Always true for the exact solver.
+    bool refined_to_eps = true;
     long setups_kept = 0;       ///< hierarchical: solves that kept the last solve's set-up (no link changed in between)
     bool emission_first = false;  ///< hierarchical: the first round refined against the emission alone (else a closed room's guess)
     double residual = 0;     ///< max over channels of ||(I - rho F) B - E||_inf / ||E||_inf

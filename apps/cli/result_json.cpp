@@ -61,6 +61,7 @@ void result_tail(ordered_json& j, const Solution& solution) {
     stats["sampled_tables"] = s.sampled_tables;
     stats["unqueried_links"] = s.unqueried_links;
     stats["passes"] = s.passes;
+    if (solution.method == "hierarchical") stats["refined_to_eps"] = s.refined_to_eps;
     stats["setups_kept"] = s.setups_kept;
     if (solution.method == "hierarchical") stats["first_round"] = s.emission_first ? "emission" : "closed_room";
     stats["residual"] = s.residual;

@@ -211,6 +211,10 @@ struct Result {
     long elements = 0;     ///< elements solved for
     long links = 0;        ///< non-zero element-pair form factors (interactions)
     double residual = 0;   ///< max over channels of ||(I - rho F) B - E||_inf / ||E||_inf
+    /// Hierarchical: the last refinement round split no link, so every link
+    /// is within eps; false when the rounds ran out first (the error may
+    /// then exceed what eps promises). Always true for the exact method.
+    bool refined_to_eps = true;
     int threads = 1;       ///< threads used
 
     std::size_t patch_count() const { return patches.size(); }

@@ -64,3 +64,13 @@ TEST_CASE("summary: an energy balance past 1e-2 is warned of, a smaller one is n
     r.solution.totals.balance[2] = 1.2e-2;
     CHECK(r.summary().find("warning: energy balance 0.012:") != std::string::npos);
 }
+
+TEST_CASE("summary: a hierarchical solve whose rounds ran out before the links settled is warned of") {
+    Solved r = solved_room("0.5");
+    REQUIRE(r.solution.stats.refined_to_eps);  // the exact solver's: always
+    CHECK(r.summary().find("warning") == std::string::npos);
+    r.solution.stats.refined_to_eps = false;
+    r.solution.stats.passes = 16;
+    CHECK(r.summary().find("warning: refinement stopped after 16 rounds with links still above the error bar") !=
+          std::string::npos);
+}

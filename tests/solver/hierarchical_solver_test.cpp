@@ -558,3 +558,27 @@ TEST_CASE("hierarchical solver: chain links along a round room: fewer links, the
             CHECK(solve_hierarchical(s).stats.chain_links > 0);
     }
 }
+
+TEST_CASE("hierarchical solver: stats.refined_to_eps says whether the rounds ran out before the links settled") {
+    // data/default.json takes three rounds at the default eps, the third
+    // splitting nothing. Capped at two, the second round still splits, and
+    // the solution says it was not refined to eps; with the cap at one
+    // nothing shows that a round would split nothing: not refined either.
+    const Scene scene = load_scene(std::string(FLATRAD_DATA_DIR) + "/default.json");
+    HierarchicalOptions o;
+    const Solution full = solve_hierarchical(scene, o);
+    REQUIRE(full.stats.passes == 3);
+    CHECK(full.stats.refined_to_eps);
+    o.max_passes = 2;
+    const Solution capped = solve_hierarchical(scene, o);
+    CHECK(capped.stats.passes == 2);
+    CHECK_FALSE(capped.stats.refined_to_eps);
+    CHECK(capped.stats.links < full.stats.links);
+    o.max_passes = 1;
+    CHECK_FALSE(solve_hierarchical(scene, o).stats.refined_to_eps);
+    // A scene that emits nothing needs no link: nothing to refine.
+    const Scene dark = parse_scene(R"({"flatrad": 1, "materials": {"w": {"reflectance": 0.5}}, "surfaces": [
+        {"name": "room", "material": "w", "closed": true, "side": "in", "points": [[0,0],[1,0],[1,1],[0,1]]}]})",
+                                   "dark.json");
+    CHECK(solve_hierarchical(dark, HierarchicalOptions{}).stats.refined_to_eps);
+}
