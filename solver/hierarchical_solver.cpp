@@ -2560,9 +2560,17 @@ std::vector<double> HierarchicalSolver::leaf_guess() const {
     // Before any solve: every patch at E + rho B_bar, B_bar the radiosity of
     // a closed room with the scene's emission and absorption (a guess that
     // errs high in open scenes, so refinement errs fine).
+    // (Over the rooms that may hold light: a dark room's absorption would
+    // lower the lit rooms' B_bar.)
+    const std::vector<char> dark = dark_patches();
+    auto in_dark_room = [&](int node) {
+        const int patch = m_nodes[static_cast<size_t>(node)].patch;
+        return static_cast<size_t>(patch) < dark.size() && dark[static_cast<size_t>(patch)];
+    };
     CompensatedSum em, ab;
     for (size_t i = 0; i < static_cast<size_t>(m_element_leaves); ++i) {
         const int node = m_leaves[i];
+        if (in_dark_room(node)) continue;
         double e = 0, a = 0;
         for (int c = 0; c < m_C; ++c) {
             e = std::max(e, emission(node, c));
@@ -2572,14 +2580,12 @@ std::vector<double> HierarchicalSolver::leaf_guess() const {
         ab.add(m_nodes[static_cast<size_t>(node)].length * a);
     }
     const double bbar = ab.value() > 0 ? em.value() / ab.value() : 0;
-    const std::vector<char> dark = dark_patches();
     std::vector<double> g(static_cast<size_t>(m_element_leaves));
     for (size_t i = 0; i < g.size(); ++i) {
         const int node = m_leaves[i];
-        const int patch = m_nodes[static_cast<size_t>(node)].patch;
-        const bool in_dark_room = static_cast<size_t>(patch) < dark.size() && dark[static_cast<size_t>(patch)];
+        const bool dark_leaf = in_dark_room(node);
         double b = 0;
-        for (int c = 0; c < m_C; ++c) b = std::max(b, emission(node, c) + (in_dark_room ? 0.0 : rho(node, c) * bbar));
+        for (int c = 0; c < m_C; ++c) b = std::max(b, emission(node, c) + (dark_leaf ? 0.0 : rho(node, c) * bbar));
         g[i] = b;
     }
     return g;

@@ -16,6 +16,7 @@
 #include "cli/progress.h"
 #include "cli/result_json.h"
 #include "cli/scene_warnings.h"
+#include "cli/tolerance_flag.h"
 #include "cli/usage_error.h"
 #include "engine/error.h"
 #include "solver/hierarchical_solver.h"
@@ -101,7 +102,8 @@ CLI::App* add_compare_command(CLI::App& app, CompareArgs& a) {
         ->type_name("E")
         ->capture_default_str();
     cmd->add_option("--vis-eps", a.vis_eps,
-                    "Visibility tolerance of the hierarchical solver, >= 0; default: eps / 10.")
+                    "Visibility tolerance of the hierarchical solver, >= 0; default: eps / 10. 0: exact "
+                    "visibility on every occluded link (none carries the density's estimate).")
         ->type_name("E");
     cmd->add_option("--subdivide", a.subdivide, "K >= 1: the first reference mesh, elements per patch.")
         ->type_name("K")
@@ -120,10 +122,8 @@ CLI::App* add_compare_command(CLI::App& app, CompareArgs& a) {
 }
 
 int run_compare(const CompareArgs& args, std::ostream& out, std::ostream& err) {
-    if (!(std::isfinite(args.eps) && args.eps > 0))
-        throw UsageError(fmt::format("--eps: expected a finite number > 0, got {}", args.eps));
-    if (!std::isfinite(args.vis_eps))
-        throw UsageError(fmt::format("--vis-eps: expected a finite number >= 0, got {}", args.vis_eps));
+    check_tolerance(args.eps, "--eps", true);
+    check_tolerance(args.vis_eps, "--vis-eps");
     if (args.subdivide < 1)
         throw UsageError(fmt::format("--subdivide: expected an integer >= 1, got {}", args.subdivide));
     if (args.max_elements < 1)
@@ -144,7 +144,7 @@ int run_compare(const CompareArgs& args, std::ostream& out, std::ostream& err) {
     // 1. Hierarchical, its progress drawn on a terminal (cli/progress.h).
     HierarchicalOptions h_options;
     h_options.eps = args.eps;
-    h_options.vis_eps = args.vis_eps;
+    h_options.vis_eps = args.vis_eps.value_or(-1);
     h_options.threads = args.threads;
     ProgressLine progress(err, !args.quiet && is_terminal_stderr(err));
     if (progress.enabled()) h_options.progress = progress.callback("compare: hierarchical: ");

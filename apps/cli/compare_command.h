@@ -11,6 +11,7 @@
 /// Output: a table on stderr (unless --quiet), the JSON object on stdout or
 /// in -o (written atomically).
 #include <iosfwd>
+#include <optional>
 #include <string>
 
 #include "cli/reference_solution.h"
@@ -31,7 +32,7 @@ struct CompareArgs {
     std::string output;       ///< JSON file; empty: stdout
     std::string reference_output;  ///< the reference's result file (SPEC.md "Result file"); empty: none
     double eps = HierarchicalOptions{}.eps;  ///< hierarchical refinement tolerance, > 0 (solve's default)
-    double vis_eps = -1;      ///< hierarchical visibility tolerance; < 0: eps / 10
+    std::optional<double> vis_eps;  ///< hierarchical visibility tolerance; absent: eps / 10
     int subdivide = 16;       ///< first reference K, >= 1
     long max_elements = default_compare_max_elements; ///< largest exact mesh (elements) tried
     int threads = 0;          ///< 0: all cores

@@ -14,6 +14,7 @@
 #include "cli/parse_whole.h"
 #include "cli/progress.h"
 #include "cli/scene_warnings.h"
+#include "cli/tolerance_flag.h"
 #include "cli/usage_error.h"
 #include "solver/hierarchical_solver.h"
 
@@ -312,11 +313,8 @@ int run_solution_sweep_command(const SweepArgs& args, std::ostream& out, std::os
     o.eps = parse_eps_list(args.eps.empty() ? default_solution_sweep_eps : args.eps);
     if (args.repeat < 1) throw UsageError(fmt::format("--repeat: expected an integer >= 1, got {}", args.repeat));
     o.repeat = args.repeat;
-    if (args.vis_eps) {
-        if (!(std::isfinite(*args.vis_eps) && *args.vis_eps >= 0))
-            throw UsageError(fmt::format("--vis-eps: expected a finite number >= 0, got {}", *args.vis_eps));
-        o.vis_eps = *args.vis_eps;
-    }
+    check_tolerance(args.vis_eps, "--vis-eps");
+    if (args.vis_eps) o.vis_eps = *args.vis_eps;
     o.threads = args.threads.value_or(0);
     if (o.threads < 0) throw UsageError(fmt::format("--threads: expected an integer >= 0, got {}", o.threads));
     o.reference.subdivide = args.subdivide.value_or(default_reference_subdivide);

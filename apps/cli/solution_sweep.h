@@ -33,7 +33,8 @@ class ProgressLine;
 /// to 1e-5, log-spaced (two per decade): a coarse picture to a fine one.
 /// It reaches 1e-5 because that is where every closed data scene's energy
 /// balance is within the 1e-4 (at 1e-4 data/closed_box.json is at
-/// 1.9e-4 and data/furnished_room.json at 3.4e-4), so that the sweep's
+/// 1.9e-4 and data/furnished_room.json at 3.4e-4, forty-seventh session;
+/// README, "Hierarchical solver", for the ninth's), so that the sweep's
 /// tightest eps shows the goal. 4 to 12 s on data/default.json, 12 to 46 s
 /// on data/tube_bank.json (one run per eps; the reference is graded further).
 inline constexpr const char* default_solution_sweep_eps = "1e-1:1e-5:9log";

@@ -11,6 +11,7 @@
 #include "cli/scene_svg.h"
 #include "cli/scene_warnings.h"
 #include "cli/summary.h"
+#include "cli/tolerance_flag.h"
 #include "cli/usage_error.h"
 #include "engine/scene.h"
 #include "solver/exact_solver.h"
@@ -20,14 +21,6 @@ namespace flatrad {
 
 namespace {
 
-// `positive`: 0 refused too, and the message says so (one rule per flag,
-// whatever the value: -1 and 0 get the same bound).
-void check_tolerance(const std::optional<double>& value, const char* flag, bool positive = false) {
-    if (value && !(std::isfinite(*value) && (positive ? *value > 0 : *value >= 0)))
-        throw UsageError(fmt::format("{}: expected a finite number {} 0{}, got {}", flag, positive ? ">" : ">=",
-                                     positive ? " (--method hierarchical; 0 would refine forever)" : "", *value));
-}
-
 void check_arguments(const SolveArgs& args) {
     if (args.method != "exact" && args.method != "hierarchical")
         throw UsageError(fmt::format("--method {}: expected exact or hierarchical", args.method));
@@ -36,7 +29,8 @@ void check_arguments(const SolveArgs& args) {
     if (args.threads < 0)
         throw UsageError(fmt::format("--threads: expected an integer >= 0 (0: all cores), got {}",
                                      args.threads));
-    check_tolerance(args.eps, "--eps", args.method == "hierarchical");
+    // (One bound whatever the value: -1 and 0 are refused alike.)
+    check_tolerance(args.eps, "--eps", args.method == "hierarchical", " (--method hierarchical; 0 would refine forever)");
     check_tolerance(args.vis_eps, "--vis-eps");
     if (!args.output.empty()) check_output_path(args.output, "-o");
     if (!args.svg.empty()) check_output_path(args.svg, "--svg");

@@ -62,9 +62,9 @@ void print_summary(std::ostream& os, const Scene& scene, const Solution& solutio
                           "near 1 makes the system stiff, and B may be off by about the residual over (1 - rho)\n",
                           s.residual);
     if (!s.refined_to_eps)
-        os << fmt::format("  warning: refinement stopped after {} rounds with links still above the error bar: the "
+        os << fmt::format("  warning: refinement stopped after {} round{} with links still above the error bar: the "
                           "error may exceed what eps promises\n",
-                          s.passes);
+                          s.passes, s.passes == 1 ? "" : "s");
     const double worst_balance = t.balance.empty() ? 0.0 : *std::max_element(t.balance.begin(), t.balance.end());
     if (worst_balance > balance_warning)
         os << fmt::format("  warning: energy balance {:.3g}: the solution loses or makes that share of the emitted "

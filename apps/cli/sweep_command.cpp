@@ -388,7 +388,7 @@ CLI::App* add_sweep_command(CLI::App& app, SweepArgs& a) {
     cmd->add_option_function<double>(
            "--vis-eps", [&a](const double& v) { a.vis_eps = v; },
            "Whole-solution sweep: the hierarchical solver's visibility tolerance, >= 0, the same for every eps; "
-           "default: eps / 10 for each eps (the solver's default).")
+           "default: eps / 10 for each eps (the solver's default). 0: exact visibility on every occluded link.")
         ->type_name("E");
     cmd->add_option_function<int>(
            "--subdivide", [&a](const int& v) { a.subdivide = v; },

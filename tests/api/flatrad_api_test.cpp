@@ -97,12 +97,14 @@ TEST_CASE("api: polygons, circles, three channels and the hierarchical solver") 
     options.eps = 1e-3;
     const api::Result h = api::solve(scene, options);
     CHECK(h.method == "hierarchical");
+    CHECK(h.refined_to_eps);  // (Result's own default is false)
     CHECK(h.patch_count() == scene.patch_count());
     CHECK(h.patches[4].side == api::Side::Right);
     CHECK(h.patches[5].side == api::Side::Out);
     api::SolveOptions exact_options;
     exact_options.method = api::Method::Exact;
     const api::Result e = api::solve(scene, exact_options);
+    CHECK(e.refined_to_eps);
     for (int c = 0; c < 3; ++c) {
         const auto k = static_cast<std::size_t>(c);
         CHECK(h.emitted[k] == doctest::Approx(e.emitted[k]));

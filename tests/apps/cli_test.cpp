@@ -104,6 +104,11 @@ TEST_CASE("cli: bad arguments give status 2 and one error line") {
         {"formfactor", scene, "--from", "lamp,", "--to", "plate"},  // empty name
         {"formfactor", scene, "--from", "lamp", "--to", "plate", "--method", "magic"},
         {"sweep"},                                   // missing SCENE, --from, --to
+        // Tolerances: the one check of every command (cli/tolerance_flag.h).
+        {"solve", scene, "--vis-eps", "-1"},
+        {"compare", scene, "--vis-eps", "-5"},       // was taken for the default (eps / 10)
+        {"compare", scene, "--eps", "0"},
+        {"sweep", scene, "--vis-eps", "-1"},
     };
     for (const auto& args : bad) {
         std::string joined;
@@ -129,6 +134,11 @@ TEST_CASE("cli: solve --method hierarchical runs and records its tolerances") {
     CHECK(result["settings"]["vis_eps"] == 0.0001);
     CHECK(result["patches"].size() > 0);
     CHECK(result["stats"]["elements"].get<long>() >= static_cast<long>(result["patches"].size()));
+    // Refined until a round split nothing (stats.refined_to_eps: the
+    // hierarchical method's alone).
+    CHECK(result["stats"]["refined_to_eps"] == true);
+    const json exact = json::parse(run({"solve", scene, "--method", "exact", "--quiet"}).out);
+    CHECK_FALSE(exact["stats"].contains("refined_to_eps"));
 
     // 0 and -1 refused alike, with the bound that holds (> 0, not >= 0).
     for (const char* bad : {"0", "-1"}) {
