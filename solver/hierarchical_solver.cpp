@@ -554,12 +554,14 @@ struct LinkError {
     bool split_r = true;  // the receiver's side makes most of it
 };
 
+// Whether material m emits in some channel.
+bool emits(const Material& m) { return *std::max_element(m.emission.begin(), m.emission.end()) > 0; }
+
 // Whether a patch of material m sends anything: it reflects or emits in
 // some channel (an element's can_send; a patch that does not, inert, is no
 // link's sender).
 bool sends(const Material& m) {
-    return *std::max_element(m.reflectance.begin(), m.reflectance.end()) > 0 ||
-           *std::max_element(m.emission.begin(), m.emission.end()) > 0;
+    return *std::max_element(m.reflectance.begin(), m.reflectance.end()) > 0 || emits(m);
 }
 
 // What the scene's connectivity says (engine/connectivity.h, solver/rooms.h,
@@ -2597,12 +2599,11 @@ std::vector<double> HierarchicalSolver::leaf_guess() const {
 std::vector<char> HierarchicalSolver::dark_patches() const {
     const size_t P = m_scene.patches.size();
     std::vector<char> dark;
-    if (!m_opt.dark_rooms_start_dark || m_side_room.size() != 2 * m_scene.segments.size()) return dark;
+    if (!m_opt.dark_rooms_start_dark) return dark;
     auto side_of = [&](const Patch& p) { return 2 * static_cast<size_t>(p.segment) + (p.lit_left ? 0 : 1); };
     std::vector<int> lit_rooms;
     for (const Patch& p : m_scene.patches) {
-        const Material& m = m_scene.materials[static_cast<size_t>(p.material)];
-        if (std::none_of(m.emission.begin(), m.emission.end(), [](double e) { return e > 0; })) continue;
+        if (!emits(m_scene.materials[static_cast<size_t>(p.material)])) continue;
         const int room = m_side_room[side_of(p)];
         if (room == room_unknown) return dark;
         lit_rooms.push_back(room);
